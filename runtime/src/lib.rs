@@ -1,0 +1,14 @@
+//! The run-time half of moreau: the [`Model`] contract that the `model!` macro
+//! implements, and (in later modules) the LCP solver, the Moreau–Jean plant
+//! stepper and the paper's velocity observers.
+//!
+//! Everything here is fixed-size (`nalgebra` `SVector`/`SMatrix` over const
+//! generics), lives on the stack, never allocates and never panics on data.
+//! The crate is `no_std`; the default `std` feature only adds
+//! `std::error::Error` impls.
+#![cfg_attr(not(feature = "std"), no_std)]
+#![warn(missing_docs)]
+
+mod model;
+
+pub use model::{Model, ModelInfo, Terms};
