@@ -11,4 +11,4 @@
 
 mod model;
 
-pub use model::{Model, ModelInfo, Terms};
+pub use model::{Linearization, Model, ModelInfo, Terms};

@@ -69,6 +69,21 @@ pub struct Terms<T: RealField + Copy, const N: usize, const K: usize> {
     pub jacobian: SMatrix<T, K, N>,
 }
 
+/// Mass matrix, total force and the force's Jacobians at one point: what an
+/// implicit time step needs (see [`Model::linearization`]).
+#[allow(non_snake_case)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Linearization<T: RealField + Copy, const N: usize> {
+    /// Mass matrix `M(q)`.
+    pub mass: SMatrix<T, N, N>,
+    /// Total force `F(t, q, v, u)`.
+    pub forces: SVector<T, N>,
+    /// `∂F/∂q`, entry `(i, j)` is `∂F_i/∂q_j`.
+    pub forces_dq: SMatrix<T, N, N>,
+    /// `∂F/∂v`, entry `(i, j)` is `∂F_i/∂v_j`.
+    pub forces_dv: SMatrix<T, N, N>,
+}
+
 /// A Lagrangian system with `N` coordinates and `K` frictionless unilateral
 /// constraints: the paper's system (8).
 ///
@@ -187,6 +202,28 @@ pub trait Model<const N: usize, const K: usize> {
         u: &Self::Input,
     ) -> (SMatrix<Self::Scalar, N, N>, SVector<Self::Scalar, N>) {
         (self.mass(q), self.forces(t, q, v, u))
+    }
+
+    /// Mass matrix, total force and the Jacobians `∂F/∂q`, `∂F/∂v`, as the
+    /// Moreau–Jean iteration matrix `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q` needs
+    /// them. Generated models compute all four from one instruction list.
+    ///
+    /// The default returns zero Jacobians: the step then treats forces
+    /// explicitly (`W = M`), as Siconos does for a model that gives none.
+    fn linearization(
+        &self,
+        t: Self::Scalar,
+        q: &SVector<Self::Scalar, N>,
+        v: &SVector<Self::Scalar, N>,
+        u: &Self::Input,
+    ) -> Linearization<Self::Scalar, N> {
+        let (mass, forces) = self.dynamics(t, q, v, u);
+        Linearization {
+            mass,
+            forces,
+            forces_dq: SMatrix::zeros(),
+            forces_dv: SMatrix::zeros(),
+        }
     }
 
     /// Gaps and their Jacobian together, `(h(q), J(q))`. Generated models

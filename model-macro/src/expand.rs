@@ -1,0 +1,64 @@
+//! The expansion as a chain of stages: front end → checks → lowering →
+//! emission. On error, the model's struct and a stub `impl Model` are still
+//! emitted beside the errors, so users see their mistakes rather than a
+//! cascade of "cannot find type".
+
+use proc_macro2::{TokenStream, TokenTree};
+
+use crate::ctxt::Ctxt;
+use crate::front::{inline, yaml};
+use crate::spec::ModelSpec;
+use crate::{check, emit, lower};
+
+/// Expands one `model!` invocation.
+pub(crate) fn model(input: TokenStream) -> TokenStream {
+    try_expand(input).unwrap_or_else(syn::Error::into_compile_error)
+}
+
+fn try_expand(input: TokenStream) -> syn::Result<TokenStream> {
+    if is_file_form(&input) {
+        let args: yaml::FileArgs = syn::parse2(input)?;
+        let span = args.path.span();
+        let (source, path) = yaml::read(&args)?;
+        let root = yaml::parse_tree(&source, span)?;
+        let text = source.text.clone();
+        let cx = Ctxt::with_yaml(source);
+        let spec = yaml::build(&cx, &root, span, &path, text);
+        finish(cx, spec)
+    } else {
+        let cx = Ctxt::new();
+        let spec = inline::build(&cx, input);
+        finish(cx, spec)
+    }
+}
+
+/// `file = "..."` selects the YAML front end.
+fn is_file_form(input: &TokenStream) -> bool {
+    let mut trees = input.clone().into_iter();
+    matches!(
+        (trees.next(), trees.next()),
+        (Some(TokenTree::Ident(k)), Some(TokenTree::Punct(p))) if k == "file" && p.as_char() == '='
+    )
+}
+
+fn finish(cx: Ctxt, spec: Option<ModelSpec>) -> syn::Result<TokenStream> {
+    let Some(spec) = spec else {
+        cx.check()?;
+        unreachable!("a front end gave up without recording an error");
+    };
+    check::check(&cx, &spec);
+    let lowered = if cx.has_errors() {
+        None
+    } else {
+        lower::lower(&cx, &spec)
+    };
+    match (cx.check(), lowered) {
+        (Ok(()), Some(model)) => Ok(emit::emit(&spec, &model)),
+        (Ok(()), None) => unreachable!("lowering failed without recording an error"),
+        (Err(errors), _) => {
+            let mut out = errors.into_compile_error();
+            out.extend(emit::fallback(&spec));
+            Ok(out)
+        }
+    }
+}

@@ -1,0 +1,422 @@
+//! The YAML front end: `model!(file = "models/parabola.yaml")`.
+//!
+//! The file is resolved against the calling crate's manifest directory and
+//! must lie inside it. Its tree is walked key by key; an unknown or
+//! malformed entry is recorded and skipped, so that every mistake in the file
+//! is reported at once, each with `path:line:column`.
+
+use std::path::{Path, PathBuf};
+
+use proc_macro2::{Span, TokenStream};
+use quote::quote;
+
+use super::keys;
+use super::yaml_tree::{YKind, YNode, YamlSource};
+use crate::ctxt::{Ctxt, Loc};
+use crate::expr::{self, Expr};
+use crate::spec::{
+    Constraint, Coordinate, Definition, Force, ModelSpec, Name, Number, Origin, Parameter,
+};
+
+/// The arguments of the file form: `file = "path"`.
+pub(crate) struct FileArgs {
+    pub path: syn::LitStr,
+}
+
+impl syn::parse::Parse for FileArgs {
+    fn parse(input: syn::parse::ParseStream<'_>) -> syn::Result<Self> {
+        let key: syn::Ident = input.parse()?;
+        if key != "file" {
+            return Err(syn::Error::new(
+                key.span(),
+                format!("expected `file = \"models/...yaml\"` or an inline model, found `{key}`"),
+            ));
+        }
+        input.parse::<syn::Token![=]>()?;
+        let path: syn::LitStr = input.parse()?;
+        input.parse::<Option<syn::Token![,]>>()?;
+        if !input.is_empty() {
+            return Err(input.error("unexpected tokens after the file path"));
+        }
+        Ok(FileArgs { path })
+    }
+}
+
+/// Finds and reads the model file. Errors (missing, unreadable, outside the
+/// crate) point at the path literal.
+pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
+    let span = args.path.span();
+    let relative = args.path.value();
+    let manifest = std::env::var("CARGO_MANIFEST_DIR")
+        .map_err(|_| syn::Error::new(span, "CARGO_MANIFEST_DIR is not set; build with cargo"))?;
+    let root = Path::new(&manifest).canonicalize().map_err(|e| {
+        syn::Error::new(
+            span,
+            format!("cannot resolve the crate directory `{manifest}`: {e}"),
+        )
+    })?;
+    let joined = root.join(&relative);
+    let path = joined.canonicalize().map_err(|e| {
+        syn::Error::new(
+            span,
+            format!(
+                "cannot read model file `{relative}` (looked for `{}`): {e}",
+                joined.display()
+            ),
+        )
+    })?;
+    if !path.starts_with(&root) {
+        return Err(syn::Error::new(
+            span,
+            format!(
+                "model file `{relative}` is outside this crate (`{}`); keep models inside the crate so cargo tracks them",
+                root.display()
+            ),
+        ));
+    }
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| syn::Error::new(span, format!("cannot read model file `{relative}`: {e}")))?;
+    Ok((
+        YamlSource {
+            display: relative,
+            text,
+        },
+        path,
+    ))
+}
+
+/// Parses the YAML text; a syntax error is reported with its position.
+pub(crate) fn parse_tree(source: &YamlSource, span: Span) -> syn::Result<YNode> {
+    source.parse().map_err(|e| {
+        let at = e
+            .location()
+            .map(|l| format!("{}:{}:{}", source.display, l.line(), l.column()))
+            .unwrap_or_else(|| source.display.clone());
+        syn::Error::new(span, format!("{at}: invalid YAML: {e}"))
+    })
+}
+
+/// Builds the model from the document tree. Returns `None` only when the
+/// document is not a mapping at all.
+pub(crate) fn build(
+    cx: &Ctxt,
+    root: &YNode,
+    span: Span,
+    path: &Path,
+    text: String,
+) -> Option<ModelSpec> {
+    let w = Walker { cx, span };
+    let YKind::Map(entries) = &root.kind else {
+        cx.error(
+            w.loc(root),
+            format!(
+                "a model file is a mapping of keys ({}), found {}",
+                keys::TOP_LEVEL.join(", "),
+                root.shape()
+            ),
+        );
+        return None;
+    };
+    let mut spec = ModelSpec {
+        name: Name {
+            text: String::new(),
+            loc: w.loc(root),
+        },
+        vis: quote!(pub),
+        doc: Vec::new(),
+        coordinates: Vec::new(),
+        parameters: Vec::new(),
+        inputs: Vec::new(),
+        definitions: Vec::new(),
+        kinetic: None,
+        potential: None,
+        forces: Vec::new(),
+        constraints: Vec::new(),
+        restitution: None,
+        initial: Vec::new(),
+        origin: Origin::Yaml {
+            path: path.display().to_string(),
+            text,
+        },
+    };
+    let mut seen: Vec<&str> = Vec::new();
+    for (key, value) in entries {
+        let Some(k) = w.key(key) else { continue };
+        if let Some(first) = seen.iter().find(|s| **s == k.text) {
+            cx.error(k.loc, format!("duplicate key `{first}`"));
+            continue;
+        }
+        match k.text.as_str() {
+            keys::NAME => {
+                if let Some(name) = w.name(value, "the model's name") {
+                    spec.name = name;
+                }
+            }
+            keys::DOC => match value.scalar_text() {
+                Some(doc) => spec.doc = doc.lines().map(str::to_string).collect(),
+                None => w.expected(value, "a text for `doc`"),
+            },
+            keys::COORDINATES => spec.coordinates = w.coordinates(value),
+            keys::PARAMETERS => {
+                spec.parameters = w
+                    .entries(value, keys::PARAMETERS)
+                    .into_iter()
+                    .filter_map(|(name, v)| {
+                        let default = w.number(v, &format!("parameter `{}`", name.text))?;
+                        Some(Parameter {
+                            name,
+                            default,
+                            doc: Vec::new(),
+                        })
+                    })
+                    .collect();
+            }
+            keys::INPUTS => match &value.kind {
+                YKind::Seq(items) => {
+                    spec.inputs = items.iter().filter_map(|i| w.name(i, "an input")).collect();
+                }
+                YKind::Null => {}
+                _ => w.expected(value, "a list of input names, like `[u1, u2]`"),
+            },
+            keys::DEFINITIONS => {
+                spec.definitions = w
+                    .entries(value, keys::DEFINITIONS)
+                    .into_iter()
+                    .filter_map(|(name, v)| {
+                        Some(Definition {
+                            name,
+                            expr: w.expr(v)?,
+                        })
+                    })
+                    .collect();
+            }
+            keys::KINETIC => spec.kinetic = w.expr(value),
+            keys::POTENTIAL => spec.potential = w.expr(value),
+            keys::FORCES => {
+                spec.forces = w
+                    .entries(value, keys::FORCES)
+                    .into_iter()
+                    .filter_map(|(coordinate, v)| {
+                        Some(Force {
+                            coordinate,
+                            expr: w.expr(v)?,
+                        })
+                    })
+                    .collect();
+            }
+            keys::CONSTRAINTS => spec.constraints = w.constraints(value),
+            keys::RESTITUTION => spec.restitution = w.number(value, "`restitution`"),
+            keys::INITIAL => {
+                spec.initial = w
+                    .entries(value, keys::INITIAL)
+                    .into_iter()
+                    .filter_map(|(name, v)| {
+                        let x = w.number(v, &format!("the initial value of `{}`", name.text))?;
+                        Some((name, x))
+                    })
+                    .collect();
+            }
+            other => {
+                cx.error(
+                    k.loc,
+                    format!(
+                        "unknown key `{other}`; a model has {}",
+                        keys::TOP_LEVEL.join(", ")
+                    ),
+                );
+                continue;
+            }
+        }
+        seen.push(
+            keys::TOP_LEVEL
+                .iter()
+                .find(|t| **t == k.text)
+                .copied()
+                .unwrap_or(""),
+        );
+    }
+    for (key, what) in [
+        (keys::NAME, "its name"),
+        (keys::COORDINATES, "its coordinates"),
+        (keys::KINETIC, "its kinetic energy"),
+    ] {
+        if !seen.contains(&key) {
+            cx.error(
+                w.loc(root),
+                format!("missing `{key}`: a model needs {what}"),
+            );
+        }
+    }
+    Some(spec)
+}
+
+/// Walks the tree, recording problems in the context.
+struct Walker<'a> {
+    cx: &'a Ctxt,
+    span: Span,
+}
+
+impl Walker<'_> {
+    fn loc(&self, node: &YNode) -> Loc {
+        Loc {
+            span: self.span,
+            node: Some(node.pos()),
+        }
+    }
+
+    fn expected(&self, node: &YNode, what: &str) {
+        self.cx.error(
+            self.loc(node),
+            format!("expected {what}, found {}", node.shape()),
+        );
+    }
+
+    fn key(&self, node: &YNode) -> Option<Name> {
+        match &node.kind {
+            YKind::Str(s) => Some(Name {
+                text: s.clone(),
+                loc: self.loc(node),
+            }),
+            _ => {
+                self.expected(node, "a key");
+                None
+            }
+        }
+    }
+
+    fn name(&self, node: &YNode, what: &str) -> Option<Name> {
+        match &node.kind {
+            YKind::Str(s) => Some(Name {
+                text: s.clone(),
+                loc: self.loc(node),
+            }),
+            _ => {
+                self.expected(node, &format!("a name for {what}"));
+                None
+            }
+        }
+    }
+
+    fn number(&self, node: &YNode, what: &str) -> Option<Number> {
+        match node.kind {
+            YKind::Num(value) => Some(Number {
+                value,
+                loc: self.loc(node),
+            }),
+            _ => {
+                self.expected(node, &format!("a number for {what}"));
+                None
+            }
+        }
+    }
+
+    fn expr(&self, node: &YNode) -> Option<Expr> {
+        let Some(text) = node.scalar_text() else {
+            self.expected(node, "an expression");
+            return None;
+        };
+        let loc = self.loc(node);
+        let toks = expr::tokenize_str(self.cx, &text, loc)?;
+        expr::parse(self.cx, &toks, loc)
+    }
+
+    /// The entries of a `name: value` mapping, in order.
+    fn entries<'n>(&self, node: &'n YNode, section: &str) -> Vec<(Name, &'n YNode)> {
+        match &node.kind {
+            YKind::Map(entries) => entries
+                .iter()
+                .filter_map(|(k, v)| Some((self.name(k, &format!("an entry of `{section}`"))?, v)))
+                .collect(),
+            YKind::Null => Vec::new(),
+            _ => {
+                self.expected(
+                    node,
+                    &format!("a mapping of `name: value` entries for `{section}`"),
+                );
+                Vec::new()
+            }
+        }
+    }
+
+    fn coordinates(&self, node: &YNode) -> Vec<Coordinate> {
+        let YKind::Seq(items) = &node.kind else {
+            self.expected(
+                node,
+                "a list of `position: velocity` entries for `coordinates`",
+            );
+            return Vec::new();
+        };
+        items
+            .iter()
+            .filter_map(|item| match &item.kind {
+                YKind::Map(entries) if entries.len() == 1 => {
+                    let (q, v) = &entries[0];
+                    Some(Coordinate {
+                        q: self.name(q, "a coordinate")?,
+                        v: self.name(v, "a velocity")?,
+                    })
+                }
+                _ => {
+                    self.expected(item, "one `position: velocity` entry, like `- x: vx`");
+                    None
+                }
+            })
+            .collect()
+    }
+
+    fn constraints(&self, node: &YNode) -> Vec<Constraint> {
+        let YKind::Seq(items) = &node.kind else {
+            self.expected(node, "a list of constraints (`- name: ..., h: ...`)");
+            return Vec::new();
+        };
+        items
+            .iter()
+            .filter_map(|item| self.constraint(item))
+            .collect()
+    }
+
+    fn constraint(&self, item: &YNode) -> Option<Constraint> {
+        let YKind::Map(entries) = &item.kind else {
+            self.expected(item, "a constraint with `name` and `h`");
+            return None;
+        };
+        let (mut name, mut h, mut restitution, mut complete) = (None, None, None, true);
+        for (key, value) in entries {
+            let Some(k) = self.key(key) else { continue };
+            match k.text.as_str() {
+                keys::NAME => name = self.name(value, "the constraint"),
+                keys::H => {
+                    h = self.expr(value);
+                    complete &= h.is_some();
+                }
+                keys::RESTITUTION => restitution = self.number(value, "`restitution`"),
+                other => self.cx.error(
+                    k.loc,
+                    format!("unknown key `{other}` in a constraint; a constraint has name, h, restitution"),
+                ),
+            }
+        }
+        if name.is_none() {
+            self.cx
+                .error(self.loc(item), "missing `name` in this constraint");
+        }
+        if h.is_none() && complete {
+            self.cx.error(
+                self.loc(item),
+                "missing `h` (the gap, `h >= 0`) in this constraint",
+            );
+        }
+        Some(Constraint {
+            name: name?,
+            h: h?,
+            restitution,
+            doc: Vec::new(),
+        })
+    }
+}
+
+/// `include_bytes!` of the model file, so that cargo rebuilds the user's
+/// crate when the file changes.
+pub(crate) fn track(path: &str) -> TokenStream {
+    quote! { const _: &[u8] = ::core::include_bytes!(#path); }
+}
