@@ -31,6 +31,16 @@ const RUST_KEYWORDS: [&str; 52] = [
     "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
 ];
 
+/// Whether `text` can name a field of the generated type: an identifier,
+/// not a keyword, not reserved.
+pub(crate) fn is_field_name(text: &str) -> bool {
+    is_identifier(text)
+        && !RUST_KEYWORDS.contains(&text)
+        && !RESERVED.contains(&text)
+        && text != keys::RESTITUTION
+        && !text.starts_with("__")
+}
+
 fn is_identifier(text: &str) -> bool {
     let mut chars = text.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')

@@ -23,8 +23,8 @@ use quote::{format_ident, quote};
 use crate::expr::fmt_number;
 use crate::front::yaml::track;
 use crate::lower::{Layout, Lowered, Var};
-use crate::render;
 use crate::spec::{ModelSpec, Origin};
+use crate::{check, render};
 
 /// The quantities the generated code returns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -943,34 +943,25 @@ fn listing(spec: &ModelSpec, lowered: &Lowered) -> String {
 /// The struct and a stub `impl Model` for a model with errors, so that the
 /// user's other uses of the type do not add errors of their own.
 pub(crate) fn fallback(spec: &ModelSpec) -> TokenStream {
-    if spec.name.text.is_empty()
-        || !spec
-            .name
-            .text
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_')
-        || spec.name.text.starts_with(|c: char| c.is_ascii_digit())
-    {
+    if !check::is_field_name(&spec.name.text) {
         return TokenStream::new();
     }
     let name = Ident::new(&spec.name.text, spec.name.loc.span);
     let vis = &spec.vis;
     let (n, k, nu) = (spec.dofs(), spec.constraint_count(), spec.inputs.len());
-    let fields = spec
-        .parameters
-        .iter()
-        .filter(|p| {
-            p.name
-                .text
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_')
-                && !p.name.text.is_empty()
-                && !p.name.text.starts_with(|c: char| c.is_ascii_digit())
-        })
-        .map(|p| {
-            let id = Ident::new(&p.name.text, Span::call_site());
-            quote!(pub #id: T,)
-        });
+    // Only parameters that make valid, distinct fields: the stub must add no
+    // error of its own.
+    let mut names: Vec<&str> = Vec::new();
+    for p in &spec.parameters {
+        let text = p.name.text.as_str();
+        if check::is_field_name(text) && !names.contains(&text) {
+            names.push(text);
+        }
+    }
+    let fields = names.iter().map(|n| {
+        let id = Ident::new(n, Span::call_site());
+        quote!(pub #id: T,)
+    });
     quote! {
         #[allow(non_snake_case, dead_code)]
         #vis struct #name<T = f64> { #(#fields)* pub restitution: ::moreau::__private::SVector<T, #k> }

@@ -5,9 +5,9 @@
 //! velocities, time, inputs, parameters. Definitions are not variables: each
 //! is built once and its node reused wherever its name appears.
 
-use moreau_sym::{Graph, Id, Lagrangian, Mechanics, VarId};
+use moreau_sym::{Graph, Id, Lagrangian, Mechanics, MechanicsError, VarId};
 
-use crate::ctxt::Ctxt;
+use crate::ctxt::{Ctxt, Loc};
 use crate::expr::{BinOp, Expr, ExprKind, Func};
 use crate::spec::{ModelSpec, Symbol};
 
@@ -122,7 +122,15 @@ pub(crate) fn lower(cx: &Ctxt, spec: &ModelSpec) -> Option<Lowered> {
         Ok(m) => m,
         Err(e) => {
             let names: Vec<&str> = spec.coordinates.iter().map(|c| c.v.text.as_str()).collect();
-            cx.error(kinetic_expr.loc, e.describe(&names));
+            let culprit = match e {
+                MechanicsError::NotQuadratic { velocity, .. }
+                | MechanicsError::LinearTerm { velocity } => Some(velocity),
+                _ => None,
+            };
+            let loc = culprit
+                .and_then(|k| first_use(spec, kinetic_expr, names[k]))
+                .unwrap_or(kinetic_expr.loc);
+            cx.error(loc, e.describe(&names));
             return None;
         }
     };
@@ -142,6 +150,27 @@ pub(crate) fn lower(cx: &Ctxt, spec: &ModelSpec) -> Option<Lowered> {
         force_dq,
         force_dv,
     })
+}
+
+/// Where `e` first uses the variable `name`, directly or through a
+/// definition (then the definition's use is given).
+fn first_use(spec: &ModelSpec, e: &Expr, name: &str) -> Option<Loc> {
+    let mut found = None;
+    e.visit_names(&mut |used, loc| {
+        if found.is_some() {
+            return;
+        }
+        let through_definition = match spec.resolve(used) {
+            Some(Symbol::Definition(i)) => {
+                first_use(spec, &spec.definitions[i].expr, name).is_some()
+            }
+            _ => false,
+        };
+        if used == name || through_definition {
+            found = Some(loc);
+        }
+    });
+    found
 }
 
 struct Builder<'a> {

@@ -55,13 +55,11 @@ pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
             format!("cannot resolve the crate directory `{manifest}`: {e}"),
         )
     })?;
-    let joined = root.join(&relative);
-    let path = joined.canonicalize().map_err(|e| {
+    let path = root.join(&relative).canonicalize().map_err(|e| {
         syn::Error::new(
             span,
             format!(
-                "cannot read model file `{relative}` (looked for `{}`): {e}",
-                joined.display()
+                "cannot read model file `{relative}` (paths are relative to the crate's directory): {e}"
             ),
         )
     })?;
@@ -69,8 +67,7 @@ pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
         return Err(syn::Error::new(
             span,
             format!(
-                "model file `{relative}` is outside this crate (`{}`); keep models inside the crate so cargo tracks them",
-                root.display()
+                "model file `{relative}` is outside this crate; keep model files inside the crate's directory"
             ),
         ));
     }

@@ -107,13 +107,34 @@ impl YamlSource {
         };
         let rest = self.text.get(index..).unwrap_or("");
         let line_len = rest.find('\n').unwrap_or(rest.len());
-        let column = match rest.as_bytes().first() {
-            Some(b'"' | b'\'') if pos.offset + 1 < line_len => column + 1 + pos.offset,
-            Some(b'|' | b'>') => column,
-            _ if pos.offset < line_len => column + pos.offset,
-            _ => column,
+        let (line, column) = match rest.as_bytes().first() {
+            Some(b'"' | b'\'') if pos.offset + 1 < line_len => (line, column + 1 + pos.offset),
+            Some(b'|' | b'>') => self.in_block(line, pos.offset).unwrap_or((line, column)),
+            _ if pos.offset < line_len => (line, column + pos.offset),
+            _ => (line, column),
         };
         format!("{}:{line}:{column}", self.display)
+    }
+
+    /// Line and column of byte `offset` of a block scalar (`|` or `>`) whose
+    /// indicator is on line `line`: its content lines follow, one more
+    /// indented, and folded or not, each line break of the source is one
+    /// character of the value.
+    fn in_block(&self, line: usize, mut offset: usize) -> Option<(usize, usize)> {
+        let lines: Vec<&str> = self.text.lines().skip(line).collect();
+        let first = lines.iter().find(|l| !l.trim().is_empty())?;
+        let indent = first.len() - first.trim_start().len();
+        for (i, l) in lines.iter().enumerate() {
+            if !l.trim().is_empty() && l.len() - l.trim_start().len() < indent {
+                break;
+            }
+            let content = l.get(indent..).unwrap_or("");
+            if offset <= content.len() {
+                return Some((line + 1 + i, indent + offset + 1));
+            }
+            offset -= content.len() + 1;
+        }
+        None
     }
 }
 
@@ -248,6 +269,21 @@ mod tests {
             offset: 4,
         };
         assert_eq!(src.describe(pos), "m.yaml:1:9");
+    }
+
+    #[test]
+    fn offsets_into_folded_block_scalars_land_on_their_line() {
+        let src = source("kinetic: >-\n  0.5 * m * vx^2\n  + vy^4\n");
+        let root = src.parse().unwrap();
+        let YKind::Map(entries) = &root.kind else {
+            panic!("root is not a map")
+        };
+        let node = entries[0].1.index;
+        // "0.5 * m * vx^2 + vy^4": `vy` is at byte 17, on the third line
+        let pos = YamlPos { node, offset: 17 };
+        assert_eq!(src.describe(pos), "m.yaml:3:5");
+        let pos = YamlPos { node, offset: 10 };
+        assert_eq!(src.describe(pos), "m.yaml:2:13");
     }
 
     #[test]

@@ -1,0 +1,8 @@
+moreau::model! {
+    pub struct Ball;
+    coordinates { y: vy }
+    parameters { m: 1.0 }
+    kinetic = 0.5 * m * vy ** 2;
+}
+
+fn main() {}

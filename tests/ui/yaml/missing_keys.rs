@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/missing_keys.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/not_quadratic.yaml");
+
+fn main() {}

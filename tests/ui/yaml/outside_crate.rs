@@ -1,0 +1,3 @@
+moreau::model!(file = "/etc/passwd");
+
+fn main() {}

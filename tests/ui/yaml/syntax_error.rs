@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/syntax_error.yaml");
+
+fn main() {}
