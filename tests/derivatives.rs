@@ -1,0 +1,313 @@
+//! The generated derivatives against independent references.
+//!
+//! 1. CasADi: `tests/casadi_reference.py` builds every shipped model in
+//!    CasADi SX, differentiates it with CasADi's own AD and evaluates M, C,
+//!    G, F, h, J, ∂F/∂q and ∂F/∂v at 32 seeded points per model (the first
+//!    four at the default parameters, the others with every parameter scaled
+//!    by a random factor in [0.5, 1.5]). Every generated method must agree to
+//!    1e-12, relative as `common::relative_error` defines it.
+//! 2. What needs no CasADi: M symmetric positive definite, the skew
+//!    symmetry of Ṁ − 2C (property (P1)), J and the force Jacobians against
+//!    central finite differences.
+
+mod common;
+
+use common::{casadi_fixture, matrix, min_eigenvalue, relative_error, vector};
+use moreau::Model;
+use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
+use nalgebra::{SMatrix, SVector};
+
+/// Agreement with CasADi required of every output.
+const CASADI_TOLERANCE: f64 = 1e-12;
+
+/// One sample point of a fixture, with the model's parameters set.
+struct Point<M, const N: usize, const NU: usize> {
+    model: M,
+    t: f64,
+    q: SVector<f64, N>,
+    v: SVector<f64, N>,
+    u: SVector<f64, NU>,
+    json: serde_json::Value,
+}
+
+fn points<M, const N: usize, const K: usize, const NU: usize>(stem: &str) -> Vec<Point<M, N, NU>>
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+{
+    let fixture = casadi_fixture(stem);
+    assert_eq!(fixture["model"], M::INFO.name);
+    let names: Vec<&str> = fixture["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap())
+        .collect();
+    assert_eq!(names, M::INFO.parameters, "parameter order");
+    let points = fixture["points"].as_array().unwrap();
+    assert!(points.len() >= 20, "{stem}: only {} points", points.len());
+    points
+        .iter()
+        .map(|p| {
+            let mut model = M::default();
+            for (i, value) in p["p"].as_array().unwrap().iter().enumerate() {
+                *model.parameter_mut(i).unwrap() = value.as_f64().unwrap();
+            }
+            Point {
+                model,
+                t: p["t"].as_f64().unwrap(),
+                q: vector(&p["q"]),
+                v: vector(&p["v"]),
+                u: vector(&p["u"]),
+                json: p.clone(),
+            }
+        })
+        .collect()
+}
+
+fn check_close<const R: usize, const C: usize>(
+    what: &str,
+    ours: &SMatrix<f64, R, C>,
+    casadi: &SMatrix<f64, R, C>,
+) {
+    let err = relative_error(ours, casadi);
+    assert!(
+        err <= CASADI_TOLERANCE,
+        "{what}: relative error {err:e}\nours   = {ours}\nCasADi = {casadi}"
+    );
+}
+
+/// Every generated method of `M` against the CasADi fixture `stem`.
+fn against_casadi<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+{
+    for (i, p) in points::<M, N, K, NU>(stem).iter().enumerate() {
+        let at = |what: &str| format!("{stem} point {i}: {what}");
+        let (m, t, q, v, u) = (&p.model, p.t, &p.q, &p.v, &p.u);
+        let mass: SMatrix<f64, N, N> = matrix(&p.json["M"]);
+        let coriolis: SMatrix<f64, N, N> = matrix(&p.json["C"]);
+        let gravity: SVector<f64, N> = vector(&p.json["G"]);
+        let forces: SVector<f64, N> = vector(&p.json["F"]);
+        let gaps: SVector<f64, K> = vector(&p.json["h"]);
+        let jacobian: SMatrix<f64, K, N> = matrix(&p.json["J"]);
+        let dfdq: SMatrix<f64, N, N> = matrix(&p.json["dFdq"]);
+        let dfdv: SMatrix<f64, N, N> = matrix(&p.json["dFdv"]);
+
+        // the per-quantity methods
+        check_close(&at("M"), &m.mass(q), &mass);
+        check_close(&at("C"), &m.coriolis(q, v), &coriolis);
+        check_close(&at("G"), &m.gravity(q), &gravity);
+        check_close(&at("F"), &m.forces(t, q, v, u), &forces);
+        check_close(&at("h"), &m.gaps(q), &gaps);
+        check_close(&at("J"), &m.gap_jacobian(q), &jacobian);
+        // the fused evaluation and its cuts
+        let all = m.eval(t, q, v, u);
+        check_close(&at("eval M"), &all.mass, &mass);
+        check_close(&at("eval C"), &all.coriolis, &coriolis);
+        check_close(&at("eval G"), &all.gravity, &gravity);
+        check_close(&at("eval F"), &all.forces, &forces);
+        check_close(&at("eval h"), &all.gaps, &gaps);
+        check_close(&at("eval J"), &all.jacobian, &jacobian);
+        let (dm, df) = m.dynamics(t, q, v, u);
+        check_close(&at("dynamics M"), &dm, &mass);
+        check_close(&at("dynamics F"), &df, &forces);
+        let (ch, cj) = m.contact(q);
+        check_close(&at("contact h"), &ch, &gaps);
+        check_close(&at("contact J"), &cj, &jacobian);
+        let lin = m.linearization(t, q, v, u);
+        check_close(&at("linearization M"), &lin.mass, &mass);
+        check_close(&at("linearization F"), &lin.forces, &forces);
+        check_close(&at("∂F/∂q"), &lin.forces_dq, &dfdq);
+        check_close(&at("∂F/∂v"), &lin.forces_dv, &dfdv);
+    }
+}
+
+#[test]
+fn parabola_matches_casadi() {
+    against_casadi::<Parabola, 2, 2, 0>("parabola");
+}
+
+#[test]
+fn three_balls_match_casadi() {
+    against_casadi::<ThreeBalls, 3, 4, 0>("three_balls");
+}
+
+#[test]
+fn billiard_matches_casadi() {
+    against_casadi::<Billiard, 2, 4, 0>("billiard");
+}
+
+#[test]
+fn double_pendulum_matches_casadi() {
+    against_casadi::<DoublePendulum, 2, 2, 0>("double_pendulum");
+}
+
+#[test]
+fn arm3_matches_casadi() {
+    against_casadi::<Arm3, 3, 1, 3>("arm3");
+}
+
+/// The restitution coefficients and the parameter defaults are the file's.
+#[test]
+fn defaults_match_the_model_files() {
+    fn defaults<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
+    where
+        M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+    {
+        let fixture = casadi_fixture(stem);
+        let model = M::default();
+        let expected: SVector<f64, K> = vector(&fixture["restitution"]);
+        assert_eq!(model.restitution(), expected, "{stem}");
+        for (i, d) in fixture["parameter_defaults"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+        {
+            assert_eq!(model.parameter(i), d.as_f64(), "{stem} parameter {i}");
+        }
+        assert_eq!(model.parameter(M::INFO.parameters.len()), None);
+    }
+    defaults::<Parabola, 2, 2, 0>("parabola");
+    defaults::<ThreeBalls, 3, 4, 0>("three_balls");
+    defaults::<Billiard, 2, 4, 0>("billiard");
+    defaults::<DoublePendulum, 2, 2, 0>("double_pendulum");
+    defaults::<Arm3, 3, 1, 3>("arm3");
+}
+
+/// Central difference of `f` at `x` along coordinate `j`, with a step
+/// relative to the magnitude of `x_j`.
+fn central<const N: usize, const R: usize>(
+    f: impl Fn(&SVector<f64, N>) -> SVector<f64, R>,
+    x: &SVector<f64, N>,
+    j: usize,
+) -> SVector<f64, R> {
+    let step = 1e-6 * x[j].abs().max(1.0);
+    let mut plus = *x;
+    let mut minus = *x;
+    plus[j] += step;
+    minus[j] -= step;
+    (f(&plus) - f(&minus)) / (2.0 * step)
+}
+
+/// What needs no CasADi, at the fixture's points: M symmetric positive
+/// definite; vᵀ(Ṁ − 2C)v = 0 with Ṁ = Σ_k ∂M/∂q_k v_k by central
+/// differences; J = ∂h/∂q and the force Jacobians against central
+/// differences. The finite-difference tolerance, 1e-6 relative, is well
+/// above the O(step²) ≈ 1e-12 truncation and the O(ε/step) ≈ 1e-10 rounding
+/// error of a central difference with step 1e-6, so it fails only on a wrong
+/// derivative.
+fn without_casadi<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+{
+    const FD_TOLERANCE: f64 = 1e-6;
+    for (i, p) in points::<M, N, K, NU>(stem).iter().enumerate() {
+        let (m, t, q, v, u) = (&p.model, p.t, &p.q, &p.v, &p.u);
+        let mass = m.mass(q);
+        assert_eq!(mass, mass.transpose(), "{stem} point {i}: M symmetric");
+        assert!(
+            min_eigenvalue(&mass) > 0.0,
+            "{stem} point {i}: M not positive definite"
+        );
+
+        let mut mdot = SMatrix::<f64, N, N>::zeros();
+        for k in 0..N {
+            let step = 1e-6 * q[k].abs().max(1.0);
+            let (mut plus, mut minus) = (*q, *q);
+            plus[k] += step;
+            minus[k] -= step;
+            mdot += (m.mass(&plus) - m.mass(&minus)) / (2.0 * step) * v[k];
+        }
+        let skew = mdot - 2.0 * m.coriolis(q, v);
+        let quadratic = (v.transpose() * skew * v)[0];
+        let scale = mdot.amax().max(m.coriolis(q, v).amax()) * v.norm_squared();
+        assert!(
+            quadratic.abs() <= FD_TOLERANCE * scale.max(1e-300),
+            "{stem} point {i}: vᵀ(Ṁ − 2C)v = {quadratic:e}"
+        );
+
+        let jac = m.gap_jacobian(q);
+        let lin = m.linearization(t, q, v, u);
+        for j in 0..N {
+            let dh = central(|x| m.gaps(x), q, j);
+            let dfq = central(|x| m.forces(t, x, v, u), q, j);
+            let dfv = central(|x| m.forces(t, q, x, u), v, j);
+            for (what, fd, exact, scale) in [
+                (
+                    "J",
+                    dh.as_slice(),
+                    jac.column(j).iter().copied().collect::<Vec<_>>(),
+                    jac.amax(),
+                ),
+                (
+                    "∂F/∂q",
+                    dfq.as_slice(),
+                    lin.forces_dq.column(j).iter().copied().collect(),
+                    lin.forces_dq.amax(),
+                ),
+                (
+                    "∂F/∂v",
+                    dfv.as_slice(),
+                    lin.forces_dv.column(j).iter().copied().collect(),
+                    lin.forces_dv.amax(),
+                ),
+            ] {
+                for (r, (a, b)) in fd.iter().zip(&exact).enumerate() {
+                    assert!(
+                        (a - b).abs() <= FD_TOLERANCE * scale.max(1.0),
+                        "{stem} point {i}: {what}[{r},{j}] = {b}, finite difference {a}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn parabola_without_casadi() {
+    without_casadi::<Parabola, 2, 2, 0>("parabola");
+}
+
+#[test]
+fn three_balls_without_casadi() {
+    without_casadi::<ThreeBalls, 3, 4, 0>("three_balls");
+}
+
+#[test]
+fn billiard_without_casadi() {
+    without_casadi::<Billiard, 2, 4, 0>("billiard");
+}
+
+#[test]
+fn double_pendulum_without_casadi() {
+    without_casadi::<DoublePendulum, 2, 2, 0>("double_pendulum");
+}
+
+#[test]
+fn arm3_without_casadi() {
+    without_casadi::<Arm3, 3, 1, 3>("arm3");
+}
+
+/// The generated code is generic over the scalar: in `f32` it agrees with
+/// `f64` to single precision.
+#[test]
+fn f32_agrees_with_f64() {
+    let m64 = DoublePendulum::<f64>::default();
+    let m32 = DoublePendulum::<f32>::default();
+    for p in points::<DoublePendulum, 2, 2, 0>("double_pendulum")
+        .iter()
+        .take(4)
+    {
+        let t64 = m64.eval(p.t, &p.q, &p.v, &SVector::zeros());
+        let t32 = m32.eval(p.t as f32, &p.q.cast(), &p.v.cast(), &SVector::zeros());
+        for (a, b) in [
+            (t64.mass, t32.mass.cast::<f64>()),
+            (t64.coriolis, t32.coriolis.cast()),
+        ] {
+            assert!(relative_error(&b, &a) < 1e-5, "{a} vs {b}");
+        }
+        assert!(relative_error(&t32.forces.cast(), &t64.forces) < 1e-5);
+        assert!(relative_error(&t32.jacobian.cast(), &t64.jacobian) < 1e-5);
+    }
+}
