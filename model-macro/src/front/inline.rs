@@ -414,11 +414,13 @@ fn constraint(cx: &Ctxt, e: Entry) -> Option<Constraint> {
     })
 }
 
+/// `a - b`, written `a + c` when `b` is `-c` (so `x >= -w` reads `x + w`).
 fn sub(a: Expr, b: Expr, loc: Loc) -> Expr {
-    Expr {
-        kind: ExprKind::Binary(BinOp::Sub, Box::new(a), Box::new(b)),
-        loc,
-    }
+    let kind = match b.kind {
+        ExprKind::Neg(c) => ExprKind::Binary(BinOp::Add, Box::new(a), c),
+        kind => ExprKind::Binary(BinOp::Sub, Box::new(a), Box::new(Expr { kind, loc: b.loc })),
+    };
+    Expr { kind, loc }
 }
 
 fn split_commas(stream: TokenStream) -> Vec<Vec<TokenTree>> {
