@@ -24,7 +24,7 @@ mod inline {
             ceiling: c - y >= 0,
         }
         restitution = 0.9;
-        initial { x: 1.0, y: 4.0, vx: 3.0, vy: 1.0 }
+        initial { x: 1.5, y: 4.0, vx: 3.0, vy: 9.0 }
     }
 }
 

@@ -10,7 +10,13 @@
 #![warn(missing_docs)]
 
 mod lcp;
+mod linalg;
 mod model;
+mod stepper;
 
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Terms};
+pub use stepper::{
+    ApproachVelocity, Impact, MoreauJean, State, StepError, StepParams, StepReport,
+    predict_index_set,
+};

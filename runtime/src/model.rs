@@ -139,7 +139,7 @@ pub trait Model<const N: usize, const K: usize> {
     type Scalar: RealField + Copy;
     /// The known inputs `u`, an `SVector<Scalar, NU>` (`NU = 0` when the
     /// model has none).
-    type Input: Copy;
+    type Input: Copy + AsRef<[Self::Scalar]>;
 
     /// Names, model text and operation count.
     const INFO: ModelInfo<N, K>;

@@ -1,0 +1,447 @@
+//! The Moreau–Jean time-stepper for the measure differential inclusion (8),
+//!
+//! $$M(q)\,dv + F(t, q, v)\,dt \in -N_{V(q)}(v_e),\qquad dq = v\,dt,$$
+//!
+//! as Siconos' `MoreauJeanOSI` in a `TimeStepping` simulation does it, so
+//! that the two agree step by step on the same model (see
+//! `tests/plant.rs` and `tests/reference/siconos_notes.md`).
+//!
+//! # One step, from `(t_k, q_k, v_k)` to `t_{k+1} = t_k + τ`
+//!
+//! 1. **Index set** (γ-prediction): constraint `α` takes part when
+//!    `h_α(q_k) + γ τ J_α(q_k) v_k ≤ 0`.
+//! 2. **Newton loop**, from the first iterate `q̃ = q_k + τ v_k`, `ṽ = v_k`:
+//!    - iteration matrix `W = M(q̃) + τθ ∂F/∂v + τ²θ² ∂F/∂q`, the
+//!      Jacobians at `(t_{k+1}, q̃, ṽ)`. This is how configuration- and
+//!      velocity-dependent forces are treated: linearly implicit, with the
+//!      Jacobians of `F` the model provides ([`Model::linearization`]),
+//!      exactly Siconos' `W` for `FInt` and `FGyr`; like Siconos, no
+//!      `∂(M(q) v)/∂q` term;
+//!    - free velocity `v_free = ṽ − W⁻¹ R`, with the residual
+//!      `R = M(q̃)(ṽ − v_k) + τ[θ F(t_{k+1}, q̃, ṽ) + (1 − θ) F(t_k, q_k, v_k)]`;
+//!    - impulses from the LCP on the index set, Newton's law per
+//!      constraint:
+//!      `0 ≤ λ ⊥ J(q̃) v_{k+1} + e u ≥ 0` with
+//!      `v_{k+1} = v_free + W⁻¹ J(q̃)ᵀ λ`, where the approach velocity `u`
+//!      is `J(q_k) v_k` in Siconos and, by default, the slower of
+//!      `J(q_k) v_k` and `J(q̃) v_k` (see [`ApproachVelocity`] for why);
+//!    - position `q_{k+1} = q_k + τ (θ v_{k+1} + (1 − θ) v_k)`;
+//!    - stop when `‖M(q_{k+1})(v_{k+1} − v_k) + τ[θ F_{k+1} + (1 − θ) F_k] − Jᵀλ‖₂`
+//!      is at most the tolerance, or after the last allowed iteration;
+//!      else iterate from `(q̃, ṽ) = (q_{k+1}, v_{k+1})`.
+//!
+//! On a smooth stretch the scheme is the θ-method; at an impact the LCP
+//! gives Newton's law with the post-impact velocity of (9f); across an
+//! accumulation of impacts (Zeno) it needs no event detection, and on a
+//! constraint surface (sliding) the velocity-level law keeps `J v ≥ 0`, so
+//! the gap drifts by `O(τ)` at most.
+//!
+//! The caller holds the state `(t, q, v)` and the stepper only settings: a
+//! step is a pure function of them, and a step that fails leaves the state
+//! as it was.
+
+mod error;
+mod params;
+mod report;
+
+pub use error::StepError;
+pub use params::{ApproachVelocity, StepParams};
+pub use report::{Impact, StepReport};
+
+use nalgebra::{RealField, SMatrix, SVector};
+
+use crate::lcp::{IndexSet, Lcp};
+use crate::linalg::{Cholesky, Lu};
+use crate::model::Model;
+
+/// The state of a mechanical system at one time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct State<T: RealField + Copy, const N: usize> {
+    /// Time `t`.
+    pub t: T,
+    /// Generalized coordinates `q`.
+    pub q: SVector<T, N>,
+    /// Generalized velocities `v` (right limits: post-impact values).
+    pub v: SVector<T, N>,
+}
+
+impl<T: RealField + Copy, const N: usize> State<T, N> {
+    /// The state `(t, q, v)`.
+    pub fn new(t: T, q: SVector<T, N>, v: SVector<T, N>) -> Self {
+        Self { t, q, v }
+    }
+}
+
+/// The Moreau–Jean stepper: settings and nothing else.
+///
+/// ```
+/// use moreau_runtime::{Model, ModelInfo, MoreauJean, State, StepParams};
+/// use nalgebra::{Matrix1, SVector, Vector1};
+///
+/// /// A unit ball above the floor y = 0, restitution 0.5.
+/// struct Ball;
+/// impl Model<1, 1> for Ball {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 1> = ModelInfo {
+///         name: "Ball", coordinates: ["y"], velocities: ["vy"], constraints: ["floor"],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> { Vector1::new(9.81) }
+///     fn forces(&self, _: f64, q: &Vector1<f64>, _: &Vector1<f64>, _: &SVector<f64, 0>) -> Vector1<f64> {
+///         self.gravity(q)
+///     }
+///     fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> { *q }
+///     fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn restitution(&self) -> Vector1<f64> { Vector1::new(0.5) }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+/// }
+///
+/// let stepper = MoreauJean::new(StepParams::new(1e-3))?;
+/// let mut state = State::new(0.0, Vector1::new(1.0), Vector1::new(0.0));
+/// let mut bounces = 0;
+/// while state.t < 1.0 {
+///     let report = stepper.step(&Ball, &mut state, &SVector::zeros())?;
+///     bounces += report.impacts().count();
+/// }
+/// // dropped from 1 m, the ball lands after √(2/9.81) = 0.45 s, leaves at
+/// // half its speed and lands again 0.45 s later
+/// assert_eq!(bounces, 2);
+/// assert!(state.q[0] >= -1e-3);
+/// # Ok::<(), moreau_runtime::StepError<f64>>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MoreauJean<T> {
+    params: StepParams<T>,
+    lcp: Lcp<T>,
+}
+
+impl<T: RealField + Copy> MoreauJean<T> {
+    /// A stepper with these settings, after checking them.
+    ///
+    /// # Errors
+    ///
+    /// [`StepError::InvalidParams`] when a setting is out of its range.
+    pub fn new(params: StepParams<T>) -> Result<Self, StepError<T>> {
+        check_params(&params)?;
+        Ok(Self {
+            params,
+            lcp: Lcp::default(),
+        })
+    }
+
+    /// The settings.
+    pub fn params(&self) -> &StepParams<T> {
+        &self.params
+    }
+
+    /// The same stepper with another LCP solver setting.
+    #[must_use]
+    pub fn with_lcp(self, lcp: Lcp<T>) -> Self {
+        Self { lcp, ..self }
+    }
+
+    /// Advances `state` by one step `τ` under the known input `u`, and says
+    /// what happened.
+    ///
+    /// # Errors
+    ///
+    /// A [`StepError`] naming the problem; `state` is then unchanged.
+    pub fn step<M, const N: usize, const K: usize>(
+        &self,
+        model: &M,
+        state: &mut State<T, N>,
+        u: &M::Input,
+    ) -> Result<StepReport<T, K>, StepError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        check_inputs(model, state, u)?;
+        let p = &self.params;
+        let (tau, theta) = (p.tau, p.theta);
+        let State {
+            t: t_k,
+            q: q_k,
+            v: v_k,
+        } = *state;
+        let t_next = t_k + tau;
+
+        // INDEX SET: γ-prediction at the start of the step.
+        let (gaps, jac_k) = model.contact(&q_k);
+        finite_matrix(&gaps, "h")?;
+        finite_matrix(&jac_k, "J")?;
+        let jv_k = jac_k * v_k;
+        let active = predict_index_set(&gaps, &jv_k, p.gamma * tau);
+        let restitution = model.restitution();
+        let forces_k = model.forces(t_k, &q_k, &v_k, u);
+        finite_matrix(&forces_k, "F")?;
+
+        // NEWTON: from the first iterate (q_k + τ v_k, v_k).
+        let mut iterate = (q_k + v_k * tau, v_k);
+        let mut report = StepReport {
+            t: t_next,
+            active,
+            impulses: SVector::zeros(),
+            lcp_trials: 0,
+            lcp_residual: T::zero(),
+            newton_iterations: 0,
+            newton_residual: T::zero(),
+            converged: false,
+        };
+        loop {
+            let (q_i, v_i) = iterate;
+            let lin = model.linearization(t_next, &q_i, &v_i, u);
+            check_mass(&lin.mass)?;
+            finite_matrix(&lin.forces, "F")?;
+            let w = iteration_matrix(&lin.mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
+            let residual = lin.mass * (v_i - v_k)
+                + forces_k * (tau * (T::one() - theta))
+                + lin.forces * (tau * theta);
+            let v_free = v_i - solve(&w, &residual)?;
+            let jac = model.gap_jacobian(&q_i);
+            finite_matrix(&jac, "J")?;
+            // Newton's law compares J v_{k+1} with e u.
+            let approach = match p.approach_velocity {
+                ApproachVelocity::Start => jv_k,
+                ApproachVelocity::Iterate => jac * v_k,
+                ApproachVelocity::Slower => jv_k.sup(&(jac * v_k)),
+            };
+            let restitution_term = restitution.component_mul(&approach);
+            let impulse = self.solve_impulses(&w, &jac, &v_free, &restitution_term, active)?;
+            let v_next = v_free + impulse.velocity_change;
+            let q_next = update_position(&q_k, &v_k, &v_next, tau, theta);
+            report.impulses = impulse.lambda;
+            report.lcp_trials += impulse.trials;
+            report.lcp_residual = impulse.residual;
+            report.newton_iterations += 1;
+            iterate = (q_next, v_next);
+            // CONVERGENCE: the residual of the dynamics at the new iterate.
+            let (mass_next, forces_next) = model.dynamics(t_next, &q_next, &v_next, u);
+            let r = mass_next * (v_next - v_k)
+                + forces_k * (tau * (T::one() - theta))
+                + forces_next * (tau * theta)
+                - jac.transpose() * impulse.lambda;
+            report.newton_residual = r.norm();
+            report.converged = report.newton_residual <= p.newton_tolerance;
+            if report.converged || report.newton_iterations >= p.newton_iterations {
+                break;
+            }
+        }
+
+        // WRITEBACK: only a finite result replaces the caller's state.
+        let (q_next, v_next) = iterate;
+        if !(q_next.iter().chain(v_next.iter()).all(|x| x.is_finite()) && t_next.is_finite()) {
+            return Err(StepError::NonFiniteResult);
+        }
+        *state = State::new(t_next, q_next, v_next);
+        Ok(report)
+    }
+
+    /// Solves the step's LCP on `active` and returns the impulses and the
+    /// velocity change `W⁻¹ Jᵀ λ` they cause.
+    fn solve_impulses<const N: usize, const K: usize>(
+        &self,
+        w: &Lu<T, N>,
+        jac: &SMatrix<T, K, N>,
+        v_free: &SVector<T, N>,
+        restitution_term: &SVector<T, K>,
+        active: IndexSet,
+    ) -> Result<Impulse<T, N, K>, StepError<T>> {
+        if active.is_empty() {
+            return Ok(Impulse::none());
+        }
+        let (delassus, w_inv_jt) = assemble_delassus(w, jac)?;
+        // With force Jacobians in W, J W⁻¹ Jᵀ is not symmetric; the LCP is
+        // posed with its symmetric part. For one active constraint that is
+        // no change at all; for several, complementarity then holds up to
+        // the skew part, O(τθ |∂F/∂v| / |M|) relative.
+        let delassus = (delassus + delassus.transpose()) * nalgebra::convert::<f64, T>(0.5);
+        let b = jac * v_free + restitution_term;
+        let solution = self.lcp.solve(&delassus, &b, active)?;
+        Ok(Impulse {
+            lambda: solution.lambda,
+            velocity_change: w_inv_jt * solution.lambda,
+            trials: solution.trials,
+            residual: solution.residual,
+        })
+    }
+}
+
+/// The outcome of the impact stage.
+struct Impulse<T: RealField + Copy, const N: usize, const K: usize> {
+    lambda: SVector<T, K>,
+    velocity_change: SVector<T, N>,
+    trials: u32,
+    residual: T,
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> Impulse<T, N, K> {
+    fn none() -> Self {
+        Self {
+            lambda: SVector::zeros(),
+            velocity_change: SVector::zeros(),
+            trials: 0,
+            residual: T::zero(),
+        }
+    }
+}
+
+/// The γ-prediction index set `{α : h_α + γτ (J v)_α ≤ 0}`, from the gaps
+/// `h`, the normal velocities `J v` and `γτ`.
+///
+/// ```
+/// use moreau_runtime::predict_index_set;
+/// use nalgebra::Vector3;
+/// let gaps = Vector3::new(0.01, 0.01, -1e-9);
+/// let normal_velocity = Vector3::new(-30.0, -1.0, 0.0);
+/// let set = predict_index_set(&gaps, &normal_velocity, 0.5e-3);
+/// // the first is predicted to close within the step, the second not, the
+/// // third has penetrated
+/// assert_eq!(set.iter().collect::<Vec<_>>(), [0, 2]);
+/// ```
+pub fn predict_index_set<T: RealField + Copy, const K: usize>(
+    gaps: &SVector<T, K>,
+    normal_velocity: &SVector<T, K>,
+    gamma_tau: T,
+) -> IndexSet {
+    let mut set = IndexSet::new();
+    for i in 0..K.min(IndexSet::CAPACITY) {
+        if gaps[i] + gamma_tau * normal_velocity[i] <= T::zero() {
+            set.insert(i);
+        }
+    }
+    set
+}
+
+/// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored.
+fn iteration_matrix<T: RealField + Copy, const N: usize>(
+    mass: &SMatrix<T, N, N>,
+    forces_dq: &SMatrix<T, N, N>,
+    forces_dv: &SMatrix<T, N, N>,
+    tau: T,
+    theta: T,
+) -> Result<Lu<T, N>, StepError<T>> {
+    let h_theta = tau * theta;
+    let w = mass + forces_dv * h_theta + forces_dq * (h_theta * h_theta);
+    finite_matrix(&w, "W")?;
+    Lu::new(&w).ok_or(StepError::SingularIterationMatrix)
+}
+
+/// `W⁻¹ x`.
+fn solve<T: RealField + Copy, const N: usize, const C: usize>(
+    w: &Lu<T, N>,
+    x: &SMatrix<T, N, C>,
+) -> Result<SMatrix<T, N, C>, StepError<T>> {
+    let x = w.solve(x);
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(StepError::SingularIterationMatrix)
+    }
+}
+
+/// The Delassus matrix `J W⁻¹ Jᵀ` and `W⁻¹ Jᵀ`.
+fn assemble_delassus<T: RealField + Copy, const N: usize, const K: usize>(
+    w: &Lu<T, N>,
+    jac: &SMatrix<T, K, N>,
+) -> Result<(SMatrix<T, K, K>, SMatrix<T, N, K>), StepError<T>> {
+    let w_inv_jt = solve(w, &jac.transpose())?;
+    Ok((jac * w_inv_jt, w_inv_jt))
+}
+
+/// `q_{k+1} = q_k + τ (θ v_{k+1} + (1 − θ) v_k)`.
+fn update_position<T: RealField + Copy, const N: usize>(
+    q_k: &SVector<T, N>,
+    v_k: &SVector<T, N>,
+    v_next: &SVector<T, N>,
+    tau: T,
+    theta: T,
+) -> SVector<T, N> {
+    q_k + (v_next * theta + v_k * (T::one() - theta)) * tau
+}
+
+fn check_params<T: RealField + Copy>(p: &StepParams<T>) -> Result<(), StepError<T>> {
+    let (zero, one) = (T::zero(), T::one());
+    let bad = |name, value| Err(StepError::InvalidParams { name, value });
+    if !(p.tau > zero && p.tau.is_finite()) {
+        return bad("tau", p.tau);
+    }
+    if !(p.theta > zero && p.theta <= one) {
+        return bad("theta", p.theta);
+    }
+    if !(p.gamma >= zero && p.gamma <= one) {
+        return bad("gamma", p.gamma);
+    }
+    if p.newton_tolerance < zero || !p.newton_tolerance.is_finite() {
+        return bad("newton_tolerance", p.newton_tolerance);
+    }
+    if p.newton_iterations == 0 {
+        return bad("newton_iterations", zero);
+    }
+    Ok(())
+}
+
+/// Rejects non-finite state, parameters and inputs, and restitution outside
+/// `[0, 1]`.
+fn check_inputs<M, T, const N: usize, const K: usize>(
+    model: &M,
+    state: &State<T, N>,
+    u: &M::Input,
+) -> Result<(), StepError<T>>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    if !state.t.is_finite() {
+        return Err(StepError::NonFiniteState {
+            which: "t",
+            index: 0,
+        });
+    }
+    for (which, x) in [("q", &state.q), ("v", &state.v)] {
+        if let Some(index) = x.iter().position(|x| !x.is_finite()) {
+            return Err(StepError::NonFiniteState { which, index });
+        }
+    }
+    let mut index = 0;
+    while let Some(p) = model.parameter(index) {
+        if !p.is_finite() {
+            return Err(StepError::NonFiniteParameter { index });
+        }
+        index += 1;
+    }
+    if let Some(index) = u.as_ref().iter().position(|x| !x.is_finite()) {
+        return Err(StepError::NonFiniteInput { index });
+    }
+    let e = model.restitution();
+    for (constraint, &value) in e.iter().enumerate() {
+        if !(value >= T::zero() && value <= T::one()) {
+            return Err(StepError::InvalidRestitution { constraint, value });
+        }
+    }
+    Ok(())
+}
+
+fn check_mass<T: RealField + Copy, const N: usize>(
+    m: &SMatrix<T, N, N>,
+) -> Result<(), StepError<T>> {
+    finite_matrix(m, "M")?;
+    match Cholesky::new(m) {
+        Some(_) => Ok(()),
+        None => Err(StepError::MassNotPositiveDefinite),
+    }
+}
+
+fn finite_matrix<T: RealField + Copy, const R: usize, const C: usize>(
+    m: &SMatrix<T, R, C>,
+    which: &'static str,
+) -> Result<(), StepError<T>> {
+    if m.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(StepError::NonFiniteModel { which })
+    }
+}

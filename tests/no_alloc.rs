@@ -1,0 +1,108 @@
+//! Zero heap allocation per step, proven with a counting global allocator:
+//! every model's evaluation, the LCP and the plant stepper through impacts,
+//! accumulations and sliding allocate nothing.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use moreau::{Model, MoreauJean, State, StepParams};
+use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
+use nalgebra::SVector;
+
+/// Counts allocations made on a thread while it is armed.
+struct Counting;
+
+thread_local! {
+    static ARMED: Cell<bool> = const { Cell::new(false) };
+    static COUNT: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if ARMED.with(Cell::get) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if ARMED.with(Cell::get) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Allocations made by `f` on this thread.
+fn allocations(f: impl FnOnce()) -> usize {
+    COUNT.with(|c| c.set(0));
+    ARMED.with(|a| a.set(true));
+    f();
+    ARMED.with(|a| a.set(false));
+    COUNT.with(Cell::get)
+}
+
+/// Steps a shipped model from its initial state for `steps` steps of 1 ms.
+fn run<M, const N: usize, const K: usize, const NU: usize>(
+    model: &M,
+    q0: SVector<f64, N>,
+    v0: SVector<f64, N>,
+    steps: usize,
+) -> usize
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
+{
+    let stepper = MoreauJean::new(StepParams::new(1e-3)).unwrap();
+    let mut state = State::new(0.0, q0, v0);
+    let u = SVector::<f64, NU>::repeat(0.1);
+    let mut impacts = 0;
+    let count = allocations(|| {
+        for _ in 0..steps {
+            let report = stepper.step(model, &mut state, &u).unwrap();
+            impacts += report.impacts().count();
+            let terms = model.eval(state.t, &state.q, &state.v, &u);
+            std::hint::black_box(terms);
+        }
+    });
+    assert!(impacts > 0, "{}: no impact in the run", M::INFO.name);
+    count
+}
+
+#[test]
+fn stepping_every_shipped_model_allocates_nothing() {
+    let (q, v) = Parabola::<f64>::initial_state();
+    assert_eq!(
+        run::<_, 2, 2, 0>(&Parabola::<f64>::default(), q, v, 6000),
+        0
+    );
+    let (q, v) = ThreeBalls::<f64>::initial_state();
+    assert_eq!(
+        run::<_, 3, 4, 0>(&ThreeBalls::<f64>::default(), q, v, 2000),
+        0
+    );
+    let (q, v) = Billiard::<f64>::initial_state();
+    assert_eq!(
+        run::<_, 2, 4, 0>(&Billiard::<f64>::default(), q, v, 2000),
+        0
+    );
+    let (q, v) = DoublePendulum::<f64>::initial_state();
+    assert_eq!(
+        run::<_, 2, 2, 0>(&DoublePendulum::<f64>::default(), q, v, 4000),
+        0
+    );
+    let (q, v) = Arm3::<f64>::initial_state();
+    assert_eq!(run::<_, 3, 1, 3>(&Arm3::<f64>::default(), q, v, 2000), 0);
+}
+
+/// The counter does count: a `Vec` allocates.
+#[test]
+fn the_counter_sees_an_allocation() {
+    assert_eq!(allocations(|| drop(std::hint::black_box(vec![1u8; 16]))), 1);
+}
