@@ -149,9 +149,11 @@ fn default_law_leaves_siconos_where_the_laws_differ() {
 /// laws part.
 #[test]
 fn siconos_law_gains_energy_on_a_dispersing_billiard() {
-    let mut model = Billiard::<f64>::default();
-    model.g = 0.0;
-    model.restitution = Vector4::repeat(1.0);
+    let model = Billiard::<f64> {
+        g: 0.0,
+        restitution: Vector4::repeat(1.0),
+        ..Default::default()
+    };
     let mut params = StepParams::new(1e-3);
     params.approach_velocity = ApproachVelocity::Start;
     let stepper = MoreauJean::new(params).unwrap();
@@ -167,9 +169,10 @@ fn siconos_law_gains_energy_on_a_dispersing_billiard() {
 
 /// Fig. 1a: ball 1 hits balls 2 and 3 at rest in contact. With both
 /// contacts active, the LCP `W λ + (1 + e) J v⁻ ⊥ λ` with
-/// `W = [[2, −1], [−1, 2]]`, `J v⁻ = (−v₀, 0)` has `λ = (1 + e) v₀ (2/3, 1/3)`
-/// > 0: both contacts stay closed in the law, so balls 2 and 3 leave glued
-/// with `(1 + e) v₀ / 3` and ball 1 keeps `(1 − 2e) v₀ / 3`.
+/// `W = [[2, −1], [−1, 2]]`, `J v⁻ = (−v₀, 0)` has the positive solution
+/// `λ = (1 + e) v₀ (2/3, 1/3)`: both contacts stay closed in the law, so
+/// balls 2 and 3 leave glued with `(1 + e) v₀ / 3` and ball 1 keeps
+/// `(1 − 2e) v₀ / 3`.
 #[test]
 fn three_balls_leave_the_impact_as_the_lcp_predicts() {
     let model = ThreeBalls::<f64>::default();
@@ -210,9 +213,11 @@ fn three_balls_leave_the_impact_as_the_lcp_predicts() {
 /// reflects exactly in the kinetic metric; flight conserves it).
 #[test]
 fn billiard_with_e_1_keeps_its_energy() {
-    let mut model = Billiard::<f64>::default();
-    model.g = 0.0;
-    model.restitution = Vector4::repeat(1.0);
+    let model = Billiard::<f64> {
+        g: 0.0,
+        restitution: Vector4::repeat(1.0),
+        ..Default::default()
+    };
     let stepper = MoreauJean::new(StepParams::new(1e-3)).unwrap();
     let mut state = State::new(0.0, Vector2::new(0.05, 0.1), Vector2::new(1.5, 0.7));
     let energy = |s: &State<f64, 2>| 0.5 * model.m * s.v.norm_squared();
@@ -235,8 +240,10 @@ fn billiard_with_e_1_keeps_its_energy() {
 /// the three balls, every step, to round-off.
 #[test]
 fn kinetic_energy_never_increases_at_an_impact() {
-    let mut billiard = Billiard::<f64>::default();
-    billiard.g = 0.0;
+    let billiard = Billiard::<f64> {
+        g: 0.0,
+        ..Default::default()
+    };
     let stepper = MoreauJean::new(StepParams::new(1e-3)).unwrap();
     let mut state = State::new(0.0, Vector2::new(0.05, 0.1), Vector2::new(1.5, 0.7));
     let mut impacts = 0;
@@ -455,8 +462,10 @@ fn bad_input_is_an_error_and_leaves_the_state_alone() {
         }
     );
 
-    let mut balls = ThreeBalls::<f64>::default();
-    balls.m2 = -1.0;
+    let balls = ThreeBalls::<f64> {
+        m2: -1.0,
+        ..Default::default()
+    };
     let (q0, v0) = ThreeBalls::<f64>::initial_state();
     let e = refused(&balls, &stepper, State::new(0.0, q0, v0));
     assert_eq!(e, StepError::MassNotPositiveDefinite);

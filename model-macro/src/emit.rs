@@ -239,11 +239,10 @@ fn body(full: &Schedule, slots_of: &Slots, slots: &[usize]) -> Body {
             continue;
         }
         let name = names[k].clone().unwrap_or_else(|| {
-            let name = role_name(&code).unwrap_or_else(|| {
+            role_name(&code).unwrap_or_else(|| {
                 anonymous += 1;
                 format!("a{}", anonymous - 1)
-            });
-            name
+            })
         });
         let name = unique(&name, &lets);
         lets.push((name.clone(), code, entries[k].clone()));

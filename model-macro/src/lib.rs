@@ -6,8 +6,9 @@
 //! allocation-free implementation of `moreau::Model`. The stages are kept
 //! apart, as in `serde_derive` and `thiserror-impl`:
 //!
-//! 1. **front ends** (`front::yaml`, `front::inline`) build one [`ModelSpec`],
-//!    in which every name and expression remembers where it came from;
+//! 1. **front ends** (`front::yaml`, `front::inline`) build one `ModelSpec`
+//!    (`spec.rs`), in which every name and expression remembers where it
+//!    came from;
 //! 2. **checks** (`check`) validate the spec, reporting every problem at once;
 //! 3. **lowering** (`lower`) builds the symbolic graph and derives the
 //!    mechanics with `moreau-sym`;
@@ -16,8 +17,6 @@
 //!
 //! Use it through the `moreau` crate, which re-exports it; the model language
 //! is described in `models/README.md`.
-//!
-//! [`ModelSpec`]: spec::ModelSpec
 
 mod check;
 mod ctxt;
