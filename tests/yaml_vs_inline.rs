@@ -3,9 +3,9 @@
 
 mod common;
 
-use common::{matrix, relative_error, vector};
+use common::vector;
 use moreau::Model;
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{SVector, Vector2};
 
 mod from_yaml {
     moreau::model!(file = "models/parabola.yaml");
@@ -50,6 +50,26 @@ mod cart_pole {
             right: bob_x <= w,
         }
         restitution = 0.8;
+    }
+}
+
+/// Every function of the model language, the time `t`, `pi`, an input, a
+/// configuration-dependent mass matrix and no constraint at all (K = 0),
+/// so that CasADi checks each derivative rule. The arguments keep `sqrt`
+/// and `ln` in their domains over the CasADi sample box (|q| ≤ 1.5).
+mod function_zoo {
+    moreau::model! {
+        /// A bead on a wire with every smooth function in it.
+        pub struct FunctionZoo;
+        coordinates { a: da, b: db }
+        parameters { m: 1.2, k: 0.7, w: 2.0 }
+        inputs { u }
+        let r2 = 4 + a^2 + b^2;
+        kinetic = 0.5 * m * (1 + 0.1 * tanh(a)^2) * da^2 + 0.5 * m * cosh(0.3 * b) * db^2
+            + 0.05 * m * sinh(0.2 * a) * da * db;
+        potential = k * (sqrt(r2) + ln(r2) + exp(-0.1 * a^2) + tan(0.3 * b) + atan2(b, 3 + a))
+            + a^4 / 4 + r2^0.75;
+        forces { a: u * cos(w * t + pi / 4) - 0.1 * da * db^2, b: -0.2 * db^3 }
     }
 }
 
@@ -116,64 +136,112 @@ fn yaml_model_text_is_the_file() {
     assert_eq!(from_yaml::Parabola::<f64>::INFO.source, file);
 }
 
-/// The inline cart-pole's model text is the committed
-/// `tests/fixtures/inline/cart_pole.yaml`, which CI puts through
-/// `tests/casadi_reference.py` to make `tests/fixtures/inline/cart_pole.json`
-/// (see `.ci/run`). If the model changes, refresh both:
+/// The inline models' texts are the committed
+/// `tests/fixtures/inline/<stem>.yaml`, which CI puts through
+/// `tests/casadi_reference.py` to make `tests/fixtures/inline/<stem>.json`
+/// (see `.ci/run`). If a model changes, refresh both:
 /// `cargo test --test yaml_vs_inline` prints the new text.
 #[test]
-fn inline_model_text_is_the_committed_file() {
-    let path = common::root().join("tests/fixtures/inline/cart_pole.yaml");
-    let committed = std::fs::read_to_string(&path).unwrap_or_default();
-    let text = cart_pole::CartPole::<f64>::INFO.source;
-    assert!(
-        committed == text,
-        "{} is stale; its text should be:\n{text}",
-        path.display()
-    );
+fn inline_model_texts_are_the_committed_files() {
+    for (stem, text) in [
+        ("cart_pole", cart_pole::CartPole::<f64>::INFO.source),
+        (
+            "function_zoo",
+            function_zoo::FunctionZoo::<f64>::INFO.source,
+        ),
+    ] {
+        let path = common::root().join(format!("tests/fixtures/inline/{stem}.yaml"));
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            committed == text,
+            "{} is stale; its text should be:\n{text}",
+            path.display()
+        );
+    }
 }
 
-/// The inline cart-pole against CasADi, to 1e-12 like the shipped models.
-#[test]
-fn inline_cart_pole_matches_casadi() {
-    let path = common::root().join("tests/fixtures/inline/cart_pole.json");
+/// An inline model against its CasADi fixture, to 1e-12 like the shipped
+/// models: every output, the force Jacobians included.
+fn inline_matches_casadi<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+{
+    let path = common::root().join(format!("tests/fixtures/inline/{stem}.json"));
     let fixture: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    assert_eq!(fixture["model"], "CartPole");
-    for point in fixture["points"].as_array().unwrap() {
-        let mut model = cart_pole::CartPole::<f64>::default();
+    assert_eq!(fixture["model"], M::INFO.name);
+    let check = |what: &str, ours: &[f64], casadi: &[f64], scale: f64| {
+        for (a, b) in ours.iter().zip(casadi) {
+            assert!(
+                (a - b).abs() <= 1e-12 * b.abs().max(scale).max(f64::MIN_POSITIVE),
+                "{stem} {what}: {ours:?} vs {casadi:?}"
+            );
+        }
+    };
+    let flat = |v: &serde_json::Value| -> Vec<f64> {
+        // rows of a matrix or a vector, flattened column-major like nalgebra
+        let rows: Vec<Vec<f64>> = match v.as_array().unwrap().first() {
+            Some(serde_json::Value::Array(_)) => v
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|r| {
+                    r.as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| x.as_f64().unwrap())
+                        .collect()
+                })
+                .collect(),
+            _ => v
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| vec![x.as_f64().unwrap()])
+                .collect(),
+        };
+        let cols = rows.first().map_or(0, Vec::len);
+        (0..cols)
+            .flat_map(|j| rows.iter().map(move |r| r[j]))
+            .collect()
+    };
+    let points = fixture["points"].as_array().unwrap();
+    assert!(points.len() >= 20);
+    for point in points {
+        let mut model = M::default();
         for (i, p) in point["p"].as_array().unwrap().iter().enumerate() {
             *model.parameter_mut(i).unwrap() = p.as_f64().unwrap();
         }
         let t = point["t"].as_f64().unwrap();
-        let q: SVector<f64, 2> = vector(&point["q"]);
-        let v: SVector<f64, 2> = vector(&point["v"]);
-        let u: SVector<f64, 1> = vector(&point["u"]);
+        let q: SVector<f64, N> = vector(&point["q"]);
+        let v: SVector<f64, N> = vector(&point["v"]);
+        let u: SVector<f64, NU> = vector(&point["u"]);
         let all = model.eval(t, &q, &v, &u);
         let lin = model.linearization(t, &q, &v, &u);
-        let pairs: [(&str, SMatrix<f64, 2, 2>, SMatrix<f64, 2, 2>); 4] = [
-            ("M", all.mass, matrix(&point["M"])),
-            ("C", all.coriolis, matrix(&point["C"])),
-            ("J", all.jacobian, matrix(&point["J"])),
-            ("∂F/∂q", lin.forces_dq, matrix(&point["dFdq"])),
-        ];
-        for (what, ours, casadi) in pairs {
-            assert!(
-                relative_error(&ours, &casadi) <= 1e-12,
-                "{what}: {ours} vs {casadi}"
-            );
-        }
-        for (what, ours, casadi) in [
-            ("G", all.gravity, vector::<2>(&point["G"])),
-            ("F", all.forces, vector::<2>(&point["F"])),
-            ("h", all.gaps, vector::<2>(&point["h"])),
+        for (what, ours) in [
+            ("M", all.mass.as_slice()),
+            ("C", all.coriolis.as_slice()),
+            ("G", all.gravity.as_slice()),
+            ("F", all.forces.as_slice()),
+            ("h", all.gaps.as_slice()),
+            ("J", all.jacobian.as_slice()),
+            ("dFdq", lin.forces_dq.as_slice()),
+            ("dFdv", lin.forces_dv.as_slice()),
         ] {
-            assert!(
-                relative_error(&ours, &casadi) <= 1e-12,
-                "{what}: {ours} vs {casadi}"
-            );
+            let casadi = flat(&point[what]);
+            let scale = casadi.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            assert_eq!(ours.len(), casadi.len(), "{what}");
+            check(what, ours, &casadi, scale);
         }
-        let dfdv: SMatrix<f64, 2, 2> = matrix(&point["dFdv"]);
-        assert!(relative_error(&lin.forces_dv, &dfdv) <= 1e-12);
     }
+}
+
+#[test]
+fn inline_cart_pole_matches_casadi() {
+    inline_matches_casadi::<cart_pole::CartPole, 2, 2, 1>("cart_pole");
+}
+
+#[test]
+fn inline_function_zoo_matches_casadi() {
+    inline_matches_casadi::<function_zoo::FunctionZoo, 2, 0, 1>("function_zoo");
 }

@@ -11,8 +11,26 @@ use crate::spec::ModelSpec;
 use crate::{check, emit, lower};
 
 /// Expands one `model!` invocation.
+///
+/// With the environment variable `MOREAU_TIMINGS` set, the expansion time
+/// of each model is printed to stderr (see it with `cargo build -vv`; touch
+/// the model file, or the source of an inline model, to expand it again).
 pub(crate) fn model(input: TokenStream) -> TokenStream {
-    try_expand(input).unwrap_or_else(syn::Error::into_compile_error)
+    let start = std::time::Instant::now();
+    let output = try_expand(input).unwrap_or_else(syn::Error::into_compile_error);
+    if std::env::var_os("MOREAU_TIMINGS").is_some() {
+        let name = output
+            .clone()
+            .into_iter()
+            .skip_while(|t| !matches!(t, TokenTree::Ident(i) if i == "struct"))
+            .nth(1)
+            .map_or_else(|| "?".to_string(), |t| t.to_string());
+        eprintln!(
+            "moreau::model! {name}: expanded in {:.2} ms",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    output
 }
 
 fn try_expand(input: TokenStream) -> syn::Result<TokenStream> {
