@@ -468,6 +468,7 @@ impl<'a> Emitter<'a> {
             }
             Code::Powi(a, n) => {
                 let a = wrap(a, a.precedence() < 4);
+                let n = proc_macro2::Literal::i32_unsuffixed(*n);
                 quote!(#a.powi(#n))
             }
             Code::Method(m, a, b) => {
@@ -517,10 +518,19 @@ impl<'a> Emitter<'a> {
         for &var in &body.unpack {
             let name = self.user_ident(var);
             let source = match self.layout.var(var) {
-                Var::Coordinate(i) => quote!(#q[#i]),
-                Var::Velocity(i) => quote!(#v[#i]),
+                Var::Coordinate(i) => {
+                    let i = int(i);
+                    quote!(#q[#i])
+                }
+                Var::Velocity(i) => {
+                    let i = int(i);
+                    quote!(#v[#i])
+                }
                 Var::Time => quote!(#t),
-                Var::Input(i) => quote!(#u[#i]),
+                Var::Input(i) => {
+                    let i = int(i);
+                    quote!(#u[#i])
+                }
                 Var::Parameter(i) => {
                     let field = Ident::new(&self.spec.parameters[i].name.text, Span::call_site());
                     quote!(self.#field)
@@ -530,6 +540,7 @@ impl<'a> Emitter<'a> {
         }
         for (name, value) in &body.constants {
             let id = Ident::new(name, Span::mixed_site());
+            let value = float(*value);
             out.extend(quote!(let #id: T = ::moreau::__private::cst(#value);));
         }
         for (name, code, _) in &body.lets {
@@ -586,8 +597,14 @@ impl<'a> Emitter<'a> {
         let vis = &spec.vis;
         let nu = spec.inputs.len();
         let (q, v, t, u) = internal_args();
-        let vec = |len: usize| quote!(::moreau::__private::SVector<T, #len>);
-        let mat = |r: usize, c: usize| quote!(::moreau::__private::SMatrix<T, #r, #c>);
+        let vec = |len: usize| {
+            let len = int(len);
+            quote!(::moreau::__private::SVector<T, #len>)
+        };
+        let mat = |r: usize, c: usize| {
+            let (r, c) = (int(r), int(c));
+            quote!(::moreau::__private::SMatrix<T, #r, #c>)
+        };
         let (vec_n, vec_k, mat_nn, mat_kn) = (vec(n), vec(k), mat(n, n), mat(k, n));
         let input = vec(nu);
 
@@ -646,7 +663,7 @@ impl<'a> Emitter<'a> {
             let j = self.matrix(k, n, |i, j| e(Quantity::Jacobian, i, j));
             quote!(::moreau::__private::Terms { mass: #m, coriolis: #c, gravity: #g, forces: #f, gaps: #h, jacobian: #j })
         });
-        let op_count = self.full.restrict(&self.eval_slots()).op_count();
+        let op_count = int(self.full.restrict(&self.eval_slots()).op_count());
 
         let strs = |names: Vec<&String>| quote!([#(#names),*]);
         let coordinates = strs(spec.coordinates.iter().map(|c| &c.q.text).collect());
@@ -661,12 +678,14 @@ impl<'a> Emitter<'a> {
         let defaults = self.defaults();
         let restitution = self.matrix(k, 1, |i, _| {
             let e = spec.restitution_of(i).map_or(0.0, |e| e.value);
+            let e = float(e);
             quote!(::moreau::__private::cst(#e))
         });
         let initial = |names: Vec<&String>| {
             let values = names.iter().map(|n| spec.initial_value(n));
             self.matrix(n, 1, |i, _| {
                 let x = values.clone().nth(i).unwrap_or(0.0);
+                let x = float(x);
                 quote!(::moreau::__private::cst(#x))
             })
         };
@@ -678,6 +697,7 @@ impl<'a> Emitter<'a> {
             .enumerate()
             .map(|(i, p)| {
                 let field = Ident::new(&p.name.text, Span::call_site());
+                let i = int(i);
                 quote!(#i => ::core::option::Option::Some(self.#field),)
             })
             .collect();
@@ -687,6 +707,7 @@ impl<'a> Emitter<'a> {
             .enumerate()
             .map(|(i, p)| {
                 let field = Ident::new(&p.name.text, Span::call_site());
+                let i = int(i);
                 quote!(#i => ::core::option::Option::Some(&mut self.#field),)
             })
             .collect();
@@ -696,6 +717,7 @@ impl<'a> Emitter<'a> {
             Origin::Inline => TokenStream::new(),
         };
         let bound = quote!(T: ::moreau::__private::RealField + ::core::marker::Copy);
+        let (n, k) = (int(n), int(k));
 
         quote! {
             #doc
@@ -819,6 +841,7 @@ impl<'a> Emitter<'a> {
                 names.join(", ")
             )
         };
+        let k = int(k);
         out.extend(quote!(#[doc = #doc] pub restitution: ::moreau::__private::SVector<T, #k>,));
         out
     }
@@ -827,7 +850,7 @@ impl<'a> Emitter<'a> {
         let mut out = TokenStream::new();
         for p in &self.spec.parameters {
             let name = Ident::new(&p.name.text, Span::call_site());
-            let value = p.default.value;
+            let value = float(p.default.value);
             out.extend(quote!(#name: ::moreau::__private::cst(#value),));
         }
         out
@@ -922,6 +945,16 @@ impl<'a> Emitter<'a> {
     }
 }
 
+/// An integer literal without a suffix (`2`, not `2usize`).
+fn int(n: usize) -> proc_macro2::Literal {
+    proc_macro2::Literal::usize_unsuffixed(n)
+}
+
+/// A float literal without a suffix (`0.5`, not `0.5f64`).
+fn float(x: f64) -> proc_macro2::Literal {
+    proc_macro2::Literal::f64_unsuffixed(x)
+}
+
 /// The method arguments `q`, `v`, `t`, `u`, with mixed-site hygiene.
 fn internal_args() -> (Ident, Ident, Ident, Ident) {
     let id = |s: &str| Ident::new(s, Span::mixed_site());
@@ -947,7 +980,11 @@ pub(crate) fn fallback(spec: &ModelSpec) -> TokenStream {
     }
     let name = Ident::new(&spec.name.text, spec.name.loc.span);
     let vis = &spec.vis;
-    let (n, k, nu) = (spec.dofs(), spec.constraint_count(), spec.inputs.len());
+    let (n, k, nu) = (
+        int(spec.dofs()),
+        int(spec.constraint_count()),
+        int(spec.inputs.len()),
+    );
     // Only parameters that make valid, distinct fields: the stub must add no
     // error of its own.
     let mut names: Vec<&str> = Vec::new();
