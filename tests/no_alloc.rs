@@ -1,11 +1,14 @@
 //! Zero heap allocation per step, proven with a counting global allocator:
-//! every model's evaluation, the LCP and the plant stepper through impacts,
-//! accumulations and sliding allocate nothing.
+//! every model's evaluation, the LCP, the plant stepper and the observers
+//! through impacts, accumulations and sliding allocate nothing.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use moreau::{Model, MoreauJean, State, StepParams};
+use moreau::{
+    Discretization, FullOrder, FullOrderGains, Model, MoreauJean, Observer, ObserverParams,
+    ReducedOrder, State, StepParams,
+};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
 
@@ -99,6 +102,70 @@ fn stepping_every_shipped_model_allocates_nothing() {
     );
     let (q, v) = Arm3::<f64>::initial_state();
     assert_eq!(run::<_, 3, 1, 3>(&Arm3::<f64>::default(), q, v, 2000), 0);
+}
+
+/// Runs a shipped model's plant for `steps` steps of 0.1 ms, then feeds
+/// every tenth position (with a little deterministic noise) to both
+/// observers under both discretizations; returns the allocations the
+/// observers made and the impacts they located.
+fn observe<M, const N: usize, const K: usize, const NU: usize>(
+    model: &M,
+    q0: SVector<f64, N>,
+    v0: SVector<f64, N>,
+    steps: usize,
+) -> (usize, u32)
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
+{
+    let stepper = MoreauJean::new(StepParams::new(1e-4)).unwrap();
+    let mut state = State::new(0.0, q0, v0);
+    let u = SVector::<f64, NU>::repeat(0.1);
+    let mut samples = Vec::with_capacity(steps / 10 + 1);
+    for k in 1..=steps {
+        stepper.step(model, &mut state, &u).unwrap();
+        if k % 10 == 0 {
+            let wiggle = 1e-7 * ((k / 10) % 7) as f64;
+            samples.push((state.t, state.q.add_scalar(wiggle)));
+        }
+    }
+    let mut impacts = 0;
+    let count = allocations(|| {
+        for scheme in [Discretization::ImpactAware, Discretization::SectionVii] {
+            let params = ObserverParams::new(10.0, 50.0)
+                .with_noise(1e-7)
+                .with_scheme(scheme);
+            let mut reduced =
+                ReducedOrder::<f64, N, K>::new(params, 0.0, q0, SVector::zeros()).unwrap();
+            let gains = FullOrderGains::scalar(5.0, 25.0);
+            let mut full =
+                FullOrder::<f64, N, K>::new(params, gains, 0.0, q0, SVector::zeros()).unwrap();
+            for (t, q) in &samples {
+                std::hint::black_box(reduced.update(model, *t, q, &u).unwrap());
+                impacts += reduced.report().impacts;
+                std::hint::black_box(full.update(model, *t, q, &u).unwrap());
+            }
+        }
+    });
+    (count, impacts)
+}
+
+#[test]
+fn observing_every_shipped_model_allocates_nothing() {
+    let (q, v) = Parabola::<f64>::initial_state();
+    let (count, impacts) = observe::<_, 2, 2, 0>(&Parabola::<f64>::default(), q, v, 60_000);
+    assert_eq!((count, impacts > 0), (0, true));
+    let (q, v) = ThreeBalls::<f64>::initial_state();
+    let (count, impacts) = observe::<_, 3, 4, 0>(&ThreeBalls::<f64>::default(), q, v, 20_000);
+    assert_eq!((count, impacts > 0), (0, true));
+    let (q, v) = Billiard::<f64>::initial_state();
+    let (count, impacts) = observe::<_, 2, 4, 0>(&Billiard::<f64>::default(), q, v, 20_000);
+    assert_eq!((count, impacts > 0), (0, true));
+    let (q, v) = DoublePendulum::<f64>::initial_state();
+    let (count, impacts) = observe::<_, 2, 2, 0>(&DoublePendulum::<f64>::default(), q, v, 40_000);
+    assert_eq!((count, impacts > 0), (0, true));
+    let (q, v) = Arm3::<f64>::initial_state();
+    let (count, _) = observe::<_, 3, 1, 3>(&Arm3::<f64>::default(), q, v, 20_000);
+    assert_eq!(count, 0);
 }
 
 /// The counter does count: a `Vec` allocates.

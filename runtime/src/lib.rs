@@ -12,10 +12,15 @@
 mod lcp;
 mod linalg;
 mod model;
+mod observer;
 mod stepper;
 
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Terms};
+pub use observer::{
+    Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
+    ObserverError, ObserverParams, ReducedOrder, UpdateReport,
+};
 pub use stepper::{
     ApproachVelocity, Impact, MoreauJean, State, StepError, StepParams, StepReport,
     predict_index_set,

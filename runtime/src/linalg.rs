@@ -1,11 +1,12 @@
 //! Small dense factorizations for any `const N`, on the stack.
 //!
-//! nalgebra's `LU` and `Cholesky` ask, for a generic `Const<N>`, for
-//! `DimMin`/typenum bounds that const-generic code cannot state; these two
-//! are the few lines a time step needs, for the sizes of a mechanical model
-//! (N up to a few tens).
+//! nalgebra's `LU`, `Cholesky` and `SymmetricEigen` ask, for a generic
+//! `Const<N>`, for `DimMin`/`DimSub`/typenum bounds that const-generic code
+//! cannot state; these are the few lines a time step and the observers'
+//! gain selection need, for the sizes of a mechanical model (N up to a few
+//! tens).
 
-use nalgebra::{RealField, SMatrix};
+use nalgebra::{RealField, SMatrix, SVector};
 
 /// `A = Pᵀ L U` with partial (row) pivoting.
 #[derive(Clone, Copy, Debug)]
@@ -83,7 +84,6 @@ impl<T: RealField + Copy, const N: usize> Lu<T, N> {
 /// `A = L Lᵀ` for symmetric positive definite `A` (the lower triangle is
 /// read).
 #[derive(Clone, Copy, Debug)]
-#[allow(dead_code)] // `solve` serves the observers, which land next
 pub(crate) struct Cholesky<T: RealField + Copy, const N: usize> {
     l: SMatrix<T, N, N>,
 }
@@ -115,7 +115,6 @@ impl<T: RealField + Copy, const N: usize> Cholesky<T, N> {
     }
 
     /// `A⁻¹ b`, column by column.
-    #[allow(dead_code)] // the observers solve with it; they land next
     pub fn solve<const C: usize>(&self, b: &SMatrix<T, N, C>) -> SMatrix<T, N, C> {
         let mut x = *b;
         for c in 0..C {
@@ -138,10 +137,110 @@ impl<T: RealField + Copy, const N: usize> Cholesky<T, N> {
     }
 }
 
+/// The eigenvalues of a symmetric `A`, by the cyclic Jacobi method.
+///
+/// Each rotation `Pᵀ A P` in the plane `(p, q)` zeroes `A_pq` (the angle
+/// from `θ = (A_qq − A_pp) / (2 A_pq)`, `t = sgn θ / (|θ| + √(θ² + 1))`, the
+/// smaller root, so that the rotation is at most 45° and stable); a sweep
+/// visits every `p < q` once, and sweeps repeat until the off-diagonal
+/// part is at round-off of the Frobenius norm (quadratic convergence: about
+/// six sweeps for the sizes of a mechanical model). Eigenvalues come to
+/// round-off of `‖A‖` each, with no ordering; nothing allocates.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SymmetricEigen<T: RealField + Copy, const N: usize> {
+    /// The eigenvalues `λ`, in no particular order.
+    pub values: SVector<T, N>,
+}
+
+impl<T: RealField + Copy, const N: usize> SymmetricEigen<T, N> {
+    /// Largest number of sweeps (never reached for finite input: Jacobi
+    /// converges quadratically once the off-diagonal part is small).
+    const MAX_SWEEPS: usize = 64;
+
+    /// Decomposes the symmetric part `(A + Aᵀ)/2` of `a`; `None` when `a` is
+    /// not finite.
+    pub fn new(a: &SMatrix<T, N, N>) -> Option<Self> {
+        if !a.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        let half: T = nalgebra::convert(0.5);
+        let mut a = (a + a.transpose()) * half;
+        let norm = a.norm();
+        let tiny = T::default_epsilon() * norm;
+        for _ in 0..Self::MAX_SWEEPS {
+            let mut off = T::zero();
+            for p in 0..N {
+                for q in p + 1..N {
+                    off += a[(p, q)] * a[(p, q)];
+                }
+            }
+            if off.sqrt() <= tiny {
+                break;
+            }
+            for p in 0..N {
+                for q in p + 1..N {
+                    let apq = a[(p, q)];
+                    if apq == T::zero() {
+                        continue;
+                    }
+                    let theta = (a[(q, q)] - a[(p, p)]) / (apq + apq);
+                    let t = if theta.abs() > nalgebra::convert(1e100) {
+                        half / theta
+                    } else {
+                        let t = T::one() / (theta.abs() + (theta * theta + T::one()).sqrt());
+                        if theta < T::zero() { -t } else { t }
+                    };
+                    let c = T::one() / (t * t + T::one()).sqrt();
+                    let s = t * c;
+                    for k in 0..N {
+                        let (akp, akq) = (a[(k, p)], a[(k, q)]);
+                        a[(k, p)] = c * akp - s * akq;
+                        a[(k, q)] = s * akp + c * akq;
+                    }
+                    for k in 0..N {
+                        let (apk, aqk) = (a[(p, k)], a[(q, k)]);
+                        a[(p, k)] = c * apk - s * aqk;
+                        a[(q, k)] = s * apk + c * aqk;
+                    }
+                }
+            }
+        }
+        Some(Self {
+            values: a.diagonal(),
+        })
+    }
+
+    /// The smallest eigenvalue (`0` for `N = 0`).
+    pub fn min(&self) -> T {
+        self.values
+            .iter()
+            .copied()
+            .reduce(T::min)
+            .unwrap_or_else(T::zero)
+    }
+
+    /// The largest eigenvalue (`0` for `N = 0`).
+    pub fn max(&self) -> T {
+        self.values
+            .iter()
+            .copied()
+            .reduce(T::max)
+            .unwrap_or_else(T::zero)
+    }
+}
+
+/// The spectral norm `‖A‖₂ = √λ_max(AᵀA)`; `None` when `a` is not finite.
+pub(crate) fn spectral_norm<T: RealField + Copy, const R: usize, const C: usize>(
+    a: &SMatrix<T, R, C>,
+) -> Option<T> {
+    let ata = a.transpose() * a;
+    SymmetricEigen::new(&ata).map(|e| e.max().max(T::zero()).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Matrix3, Vector3};
+    use nalgebra::{Matrix2, Matrix3, Matrix4, Vector3};
 
     #[test]
     fn lu_solves_a_system_that_needs_pivoting() {
@@ -174,5 +273,54 @@ mod tests {
         let a = SMatrix::<f64, 0, 0>::zeros();
         assert!(Lu::new(&a).is_some());
         assert!(Cholesky::new(&a).is_some());
+    }
+
+    #[test]
+    fn jacobi_agrees_with_nalgebra_on_fixed_sizes() {
+        // deterministic pseudo-random symmetric matrices
+        let mut x = 0.5_f64;
+        let mut next = || {
+            x = (x * 3.7 + 0.1).fract();
+            2.0 * x - 1.0
+        };
+        for _ in 0..20 {
+            let b = Matrix4::from_fn(|_, _| next());
+            let a = b + b.transpose();
+            let ours = SymmetricEigen::new(&a).unwrap();
+            let theirs = a.symmetric_eigen();
+            let mut o: Vec<f64> = ours.values.iter().copied().collect();
+            let mut t: Vec<f64> = theirs.eigenvalues.iter().copied().collect();
+            o.sort_by(f64::total_cmp);
+            t.sort_by(f64::total_cmp);
+            for (o, t) in o.iter().zip(&t) {
+                assert!((o - t).abs() < 1e-13 * a.norm(), "{o} vs {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn jacobi_on_known_matrices() {
+        // [[2, 1], [1, 2]]: eigenvalues 1 and 3
+        let e = SymmetricEigen::new(&Matrix2::new(2.0_f64, 1.0, 1.0, 2.0)).unwrap();
+        assert!((e.min() - 1.0).abs() < 1e-15 && (e.max() - 3.0).abs() < 1e-15);
+        // already diagonal: no rotation at all
+        let d = Matrix3::from_diagonal(&Vector3::new(3.0, -1.0, 2.0));
+        let e = SymmetricEigen::new(&d).unwrap();
+        assert_eq!(e.values, Vector3::new(3.0, -1.0, 2.0));
+        // the off-diagonal sweep of a tiny entry: a rotation of ~1e-150
+        let e = SymmetricEigen::new(&Matrix2::new(1.0_f64, 1e-150, 1e-150, 2.0)).unwrap();
+        assert_eq!((e.min(), e.max()), (1.0, 2.0));
+        assert!(SymmetricEigen::new(&Matrix2::from_element(f64::NAN)).is_none());
+        let empty = SymmetricEigen::new(&SMatrix::<f64, 0, 0>::zeros()).unwrap();
+        assert_eq!((empty.min(), empty.max()), (0.0, 0.0));
+    }
+
+    #[test]
+    fn spectral_norm_of_a_rectangular_matrix() {
+        // singular values of [[3, 0], [4, 5]] are √45 and √5
+        let a = Matrix2::new(3.0, 0.0, 4.0, 5.0);
+        assert!((spectral_norm(&a).unwrap() - 45.0_f64.sqrt()).abs() < 1e-14);
+        let r = nalgebra::SMatrix::<f64, 1, 3>::new(1.0, 2.0, 2.0);
+        assert!((spectral_norm(&r).unwrap() - 3.0).abs() < 1e-15);
     }
 }

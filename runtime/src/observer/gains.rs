@@ -1,0 +1,537 @@
+//! Gain selection: the constants of Corollaries 2 and 3 estimated from a
+//! model's generated code over a box of configurations, and the gain `l_d`
+//! they ask for.
+//!
+//! # The constants
+//!
+//! Over the box `q_min ≤ q ≤ q_max` and the ball `|v| ≤ C_v`:
+//!
+//! - `λ_min = inf λ_min(M(q))` (and `λ_max = sup λ_max(M(q))`, for the
+//!   constant `√(λ_max/λ_min)` of Theorem 2), by the Jacobi eigenvalues of
+//!   `M(q)`;
+//! - `C_M = sup ‖C(q, d)‖₂` over unit `d`: `C` is linear in `v`, so
+//!   `‖C(q, v)‖ ≤ C_M |v|`, the property (P2);
+//! - `C_F = sup ‖∂F/∂v(t, q, v)‖₂` over `|v| ≤ C_v`, from
+//!   [`Model::linearization`]: `F̄(t, q, ·) = F(t, q, sat(·))` and `sat` is
+//!   1-Lipschitz, so `C_F` is a Lipschitz constant of `F̄` in `v` on all of
+//!   `ℝⁿ`. (A hand-written model that keeps the default `linearization`,
+//!   whose Jacobians are zero, gets `C_F = 0`.)
+//!
+//! # Sampling
+//!
+//! Deterministic, so that the same model and box give the same bits:
+//!
+//! - configurations: the `2^N` corners of the box (for `N ≤ 10`), its
+//!   centre, and the first [`GainRegion::configurations`] points of the
+//!   Halton sequence in bases `2, 3, 5, …` (the first `N` primes), scaled
+//!   to the box;
+//! - directions: `±e_k`, and the first [`GainRegion::directions`] points
+//!   of the Halton sequence in the next `N` prime bases, mapped to
+//!   `[−1, 1]^N` and normalised;
+//! - velocities for `C_F`: `v = 0`, and `C_v d`, `C_v d/2` for each
+//!   direction (`∂F/∂v` of the Lagrangian part `C(q, v) v` is affine in
+//!   `v`, so its norm is largest on the sphere; the half radius catches
+//!   extra forces that are not).
+//!
+//! Sampling finds a supremum from below: the estimates are what the
+//! samples show, not bounds. Where the guarantee matters, add a margin to
+//! `β` or sample more.
+//!
+//! # The gain
+//!
+//! Corollary 2 (full order) asks `λ_min l_d > C_F + C_M C_v + β`,
+//! Corollary 3 (reduced order) `λ_min l_d ≥ 2 C_v C_M + 2 C_F + β`.
+//! [`ModelBounds::gain`] returns the `l_d` at which the condition holds
+//! with equality, [`ModelBounds::beta`] the margin `β` a given `l_d` leaves.
+//!
+//! The paper's `β` is a margin in the units of `M` over time: with
+//! `W = ṽᵀ M ṽ`, the proof shows `dW/dt ≤ −2 l_d W + 2 (C_F + C_M C_v)|ṽ|²`
+//! between impacts (and `W` does not grow at impacts), hence
+//!
+//! $$|\tilde v(t)|_M \le e^{-r t}\,|\tilde v(0)|_M,\qquad r = l_d - \frac{C_F + C_M C_v}{\underline\lambda_M},$$
+//!
+//! the rate [`ModelBounds::decay_rate`] returns, in 1/s: Corollary 2's `β`
+//! over `λ_min`. When Corollary 3 holds (`β₃ ≥ 0`) and `λ_min ≤ 1`, it is
+//! at least Corollary 3's `β₃`: with `c = C_F + C_M C_v ≤ λ l_d / 2`,
+//! `r − β₃ = l_d (1 − λ) + c (2 − 1/λ)`, both terms non-negative for
+//! `λ ≥ 1/2`, and at least `l_d (1 − λ) + l_d (λ − 1/2) = l_d/2` below. The
+//! Euclidean error follows `r` up to the factor `√(λ_max/λ_min)`. For the
+//! full-order observer, with `Λ = λI` and `L_ρ1 = ρI`, the Lyapunov
+//! function of Theorem 2 decays at `min(λ, r)`.
+
+use nalgebra::{RealField, SVector};
+
+use crate::linalg::{SymmetricEigen, spectral_norm};
+use crate::model::Model;
+
+use super::ObserverError;
+
+/// Which observer the gain is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Design {
+    /// The full-order observer (36), Corollary 2:
+    /// `λ_min l_d > C_F + C_M C_v + β`.
+    FullOrder,
+    /// The reduced-order observer (38), Corollary 3:
+    /// `λ_min l_d ≥ 2 C_v C_M + 2 C_F + β`.
+    ReducedOrder,
+}
+
+/// Where the constants are estimated: a box of configurations, the
+/// velocity bound `C_v`, and how densely to sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainRegion<T: RealField + Copy, const N: usize> {
+    /// Lower corner of the box of configurations.
+    pub q_min: SVector<T, N>,
+    /// Upper corner of the box of configurations.
+    pub q_max: SVector<T, N>,
+    /// The velocity bound `C_v > 0` of Assumption 1.
+    pub velocity_bound: T,
+    /// The time at which `F(t, q, v, u)` is evaluated (default `0`).
+    pub t: T,
+    /// Halton points in the box, besides its corners and centre (default
+    /// `512`).
+    pub configurations: usize,
+    /// Halton directions, besides `±e_k` (default `64`).
+    pub directions: usize,
+}
+
+impl<T: RealField + Copy, const N: usize> GainRegion<T, N> {
+    /// The box `[q_min, q_max]` with velocity bound `C_v`, and the default
+    /// sampling.
+    #[must_use]
+    pub fn new(q_min: SVector<T, N>, q_max: SVector<T, N>, velocity_bound: T) -> Self {
+        Self {
+            q_min,
+            q_max,
+            velocity_bound,
+            t: T::zero(),
+            configurations: 512,
+            directions: 64,
+        }
+    }
+
+    fn check(&self) -> Result<(), ObserverError<T>> {
+        let bad = |name, value| Err(ObserverError::InvalidParams { name, value });
+        for i in 0..N {
+            let (lo, hi) = (self.q_min[i], self.q_max[i]);
+            if !(lo.is_finite() && hi.is_finite()) {
+                return bad("q_min/q_max", if lo.is_finite() { hi } else { lo });
+            }
+            if lo > hi {
+                return bad("q_min", lo);
+            }
+        }
+        if !(self.velocity_bound > T::zero() && self.velocity_bound.is_finite()) {
+            return bad("velocity_bound", self.velocity_bound);
+        }
+        if !self.t.is_finite() {
+            return bad("t", self.t);
+        }
+        Ok(())
+    }
+
+    /// Configuration sample `index` (corners, centre, then Halton).
+    fn configuration(&self, index: usize) -> SVector<T, N> {
+        let corners = if N <= 10 { 1usize << N } else { 0 };
+        let span = self.q_max - self.q_min;
+        if index < corners {
+            let mut q = self.q_min;
+            for j in 0..N {
+                if index >> j & 1 == 1 {
+                    q[j] = self.q_max[j];
+                }
+            }
+            return q;
+        }
+        let k = index - corners;
+        let mut q = self.q_min;
+        for j in 0..N {
+            let x = if k == 0 {
+                0.5
+            } else {
+                radical_inverse(k as u64, prime(j))
+            };
+            q[j] += span[j] * nalgebra::convert::<f64, T>(x);
+        }
+        q
+    }
+
+    fn configuration_count(&self) -> usize {
+        (if N <= 10 { 1usize << N } else { 0 }) + 1 + self.configurations
+    }
+
+    /// Unit direction `index` (`±e_k`, then Halton), or `None` for a Halton
+    /// point too close to the origin to normalise.
+    fn direction(&self, index: usize) -> Option<SVector<T, N>> {
+        if index < 2 * N {
+            let mut d = SVector::zeros();
+            d[index / 2] = if index % 2 == 0 { T::one() } else { -T::one() };
+            return Some(d);
+        }
+        let k = (index - 2 * N + 1) as u64;
+        let mut d = SVector::<T, N>::zeros();
+        for j in 0..N {
+            d[j] = nalgebra::convert(2.0 * radical_inverse(k, prime(N + j)) - 1.0);
+        }
+        let n = d.norm();
+        (n > nalgebra::convert(1e-3)).then(|| d / n)
+    }
+}
+
+/// The constants of Corollaries 2 and 3 estimated over a [`GainRegion`].
+///
+/// ```
+/// use moreau_runtime::{Design, GainRegion, Model, ModelBounds, ModelInfo};
+/// use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+///
+/// /// A point mass m with viscous damping b in the plane, no constraint.
+/// struct Puck { m: f64, b: f64 }
+/// impl Model<2, 0> for Puck {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<2, 0> = ModelInfo {
+///         name: "Puck", coordinates: ["x", "y"], velocities: ["vx", "vy"], constraints: [],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector2<f64>) -> Matrix2<f64> { Matrix2::identity() * self.m }
+///     fn coriolis(&self, _: &Vector2<f64>, _: &Vector2<f64>) -> Matrix2<f64> { Matrix2::zeros() }
+///     fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> { Vector2::zeros() }
+///     fn forces(&self, _: f64, _: &Vector2<f64>, v: &Vector2<f64>, _: &SVector<f64, 0>) -> Vector2<f64> {
+///         v * self.b
+///     }
+///     fn gaps(&self, _: &Vector2<f64>) -> SVector<f64, 0> { SVector::zeros() }
+///     fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 0, 2> { SMatrix::zeros() }
+///     fn restitution(&self) -> SVector<f64, 0> { SVector::zeros() }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+///     fn linearization(&self, t: f64, q: &Vector2<f64>, v: &Vector2<f64>, u: &SVector<f64, 0>)
+///         -> moreau_runtime::Linearization<f64, 2> {
+///         moreau_runtime::Linearization {
+///             mass: self.mass(q),
+///             forces: self.forces(t, q, v, u),
+///             forces_dq: Matrix2::zeros(),
+///             forces_dv: Matrix2::identity() * self.b,
+///         }
+///     }
+/// }
+///
+/// let region = GainRegion::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0), 5.0);
+/// let bounds = ModelBounds::estimate(&Puck { m: 2.0, b: 0.5 }, &region, &SVector::zeros())?;
+/// assert_eq!((bounds.mass_min, bounds.coriolis, bounds.force_lipschitz), (2.0, 0.0, 0.5));
+/// // Corollary 3 for β = 10: 2 l_d ≥ 2·0.5 + 10
+/// assert_eq!(bounds.gain(Design::ReducedOrder, 10.0), 5.5);
+/// // the velocity error of l_d = 5.5 decays at least like e^{-(5.5 - 0.5/2) t}
+/// assert_eq!(bounds.decay_rate(5.5), 5.25);
+/// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelBounds<T> {
+    /// `λ_min`: the smallest eigenvalue of `M(q)` seen.
+    pub mass_min: T,
+    /// `λ_max`: the largest eigenvalue of `M(q)` seen.
+    pub mass_max: T,
+    /// `C_M`: the largest `‖C(q, d)‖₂` seen over unit directions `d`.
+    pub coriolis: T,
+    /// `C_F`: the largest `‖∂F/∂v‖₂` seen over `|v| ≤ C_v`.
+    pub force_lipschitz: T,
+    /// The velocity bound `C_v` of the region.
+    pub velocity_bound: T,
+    /// Configurations sampled.
+    pub configurations: usize,
+    /// Model evaluations made (mass, Coriolis and linearization).
+    pub evaluations: usize,
+}
+
+impl<T: RealField + Copy> ModelBounds<T> {
+    /// Estimates the constants of `model` over `region` with the known
+    /// input `u` (see "Sampling" in the module docs of
+    /// `runtime/src/observer/gains.rs`).
+    ///
+    /// # Errors
+    ///
+    /// [`ObserverError::InvalidParams`] for a region that is not a finite
+    /// box with `C_v > 0`, [`ObserverError::MassNotPositiveDefinite`] where
+    /// `M(q)` is not, [`ObserverError::NonFiniteModel`] where the model
+    /// evaluates to NaN, [`ObserverError::NonFiniteInput`] for a
+    /// non-finite `u`.
+    pub fn estimate<M, const N: usize, const K: usize>(
+        model: &M,
+        region: &GainRegion<T, N>,
+        u: &M::Input,
+    ) -> Result<Self, ObserverError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        region.check()?;
+        if let Some(index) = u.as_ref().iter().position(|x| !x.is_finite()) {
+            return Err(ObserverError::NonFiniteInput { index });
+        }
+        let c_v = region.velocity_bound;
+        let half: T = nalgebra::convert(0.5);
+        let mut bounds = Self {
+            mass_min: T::zero(),
+            mass_max: T::zero(),
+            coriolis: T::zero(),
+            force_lipschitz: T::zero(),
+            velocity_bound: c_v,
+            configurations: region.configuration_count(),
+            evaluations: 0,
+        };
+        let mut first = true;
+        let directions = 2 * N + region.directions;
+        for index in 0..bounds.configurations {
+            let q = region.configuration(index);
+            let mass = model.mass(&q);
+            let eigen =
+                SymmetricEigen::new(&mass).ok_or(ObserverError::NonFiniteModel { which: "M" })?;
+            // finite (the matrix was), so `≤ 0` is the whole test
+            if eigen.min() <= T::zero() {
+                return Err(ObserverError::MassNotPositiveDefinite);
+            }
+            if first {
+                (bounds.mass_min, bounds.mass_max, first) = (eigen.min(), eigen.max(), false);
+            } else {
+                bounds.mass_min = bounds.mass_min.min(eigen.min());
+                bounds.mass_max = bounds.mass_max.max(eigen.max());
+            }
+            let lin = model.linearization(region.t, &q, &SVector::zeros(), u);
+            bounds.force_lipschitz = bounds.force_lipschitz.max(norm(&lin.forces_dv, "dF/dv")?);
+            bounds.evaluations += 2;
+            for d in (0..directions).filter_map(|j| region.direction(j)) {
+                let c = model.coriolis(&q, &d);
+                bounds.coriolis = bounds.coriolis.max(norm(&c, "C")?);
+                for radius in [c_v, c_v * half] {
+                    let lin = model.linearization(region.t, &q, &(d * radius), u);
+                    let dv = norm(&lin.forces_dv, "dF/dv")?;
+                    bounds.force_lipschitz = bounds.force_lipschitz.max(dv);
+                }
+                bounds.evaluations += 3;
+            }
+        }
+        Ok(bounds)
+    }
+
+    /// The `l_d` at which `design`'s corollary holds with equality for the
+    /// margin `β`: `(C_F + C_M C_v + β)/λ_min` (Corollary 2; its strict
+    /// inequality holds for any larger `l_d`) or
+    /// `(2 C_v C_M + 2 C_F + β)/λ_min` (Corollary 3).
+    pub fn gain(&self, design: Design, beta: T) -> T {
+        (self.coupling(design) + beta) / self.mass_min
+    }
+
+    /// The margin `β = λ_min l_d − (C_F + C_M C_v)` (Corollary 2) or
+    /// `λ_min l_d − 2 (C_v C_M + C_F)` (Corollary 3) that `l_d` leaves;
+    /// negative when `l_d` is too small for the corollary.
+    pub fn beta(&self, design: Design, l_d: T) -> T {
+        self.mass_min * l_d - self.coupling(design)
+    }
+
+    /// The guaranteed exponential decay rate (1/s) of the velocity error
+    /// in the kinetic metric, `r = l_d − (C_F + C_M C_v)/λ_min` (see the
+    /// module docs of `runtime/src/observer/gains.rs`: Corollary 2's `β`
+    /// over `λ_min`).
+    pub fn decay_rate(&self, l_d: T) -> T {
+        l_d - self.coupling(Design::FullOrder) / self.mass_min
+    }
+
+    /// `C_F + C_M C_v`, twice that for Corollary 3.
+    fn coupling(&self, design: Design) -> T {
+        let c = self.force_lipschitz + self.coriolis * self.velocity_bound;
+        match design {
+            Design::FullOrder => c,
+            Design::ReducedOrder => c + c,
+        }
+    }
+}
+
+/// `‖m‖₂`, or the error naming the model term that was not finite.
+fn norm<T: RealField + Copy, const N: usize>(
+    m: &nalgebra::SMatrix<T, N, N>,
+    which: &'static str,
+) -> Result<T, ObserverError<T>> {
+    spectral_norm(m).ok_or(ObserverError::NonFiniteModel { which })
+}
+
+/// The first 64 primes: the Halton bases.
+const PRIMES: [u64; 64] = [
+    2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79, 83, 89, 97,
+    101, 103, 107, 109, 113, 127, 131, 137, 139, 149, 151, 157, 163, 167, 173, 179, 181, 191, 193,
+    197, 199, 211, 223, 227, 229, 233, 239, 241, 251, 257, 263, 269, 271, 277, 281, 283, 293, 307,
+    311,
+];
+
+/// The Halton base of coordinate `j` (bases repeat past the 64th).
+fn prime(j: usize) -> u64 {
+    PRIMES[j % PRIMES.len()]
+}
+
+/// The van der Corput radical inverse of `index` in `base`: its digits
+/// mirrored about the radix point, in `[0, 1)`.
+fn radical_inverse(mut index: u64, base: u64) -> f64 {
+    let (mut scale, mut x) = (1.0, 0.0);
+    while index > 0 {
+        scale /= base as f64;
+        x += scale * (index % base) as f64;
+        index /= base;
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Linearization, ModelInfo};
+    use nalgebra::{Matrix2, SMatrix, Vector2};
+
+    /// A particle of mass `m` in polar coordinates `(r, θ)`, no potential:
+    /// `M = diag(m, m r²)`, `C = m r [[0, −θ̇], [θ̇, ṙ]]`, `F = C v` and
+    /// `∂F/∂v = 2C`.
+    struct Polar {
+        m: f64,
+    }
+
+    impl Model<2, 0> for Polar {
+        type Scalar = f64;
+        type Input = SVector<f64, 0>;
+        const INFO: ModelInfo<2, 0> = ModelInfo {
+            name: "Polar",
+            coordinates: ["r", "theta"],
+            velocities: ["dr", "dtheta"],
+            constraints: [],
+            parameters: &[],
+            inputs: &[],
+            source: "",
+            op_count: 0,
+        };
+        fn mass(&self, q: &Vector2<f64>) -> Matrix2<f64> {
+            Matrix2::new(self.m, 0.0, 0.0, self.m * q[0] * q[0])
+        }
+        fn coriolis(&self, q: &Vector2<f64>, v: &Vector2<f64>) -> Matrix2<f64> {
+            Matrix2::new(0.0, -v[1], v[1], v[0]) * (self.m * q[0])
+        }
+        fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> {
+            Vector2::zeros()
+        }
+        fn forces(
+            &self,
+            _: f64,
+            q: &Vector2<f64>,
+            v: &Vector2<f64>,
+            _: &SVector<f64, 0>,
+        ) -> Vector2<f64> {
+            self.coriolis(q, v) * v
+        }
+        fn gaps(&self, _: &Vector2<f64>) -> SVector<f64, 0> {
+            SVector::zeros()
+        }
+        fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 0, 2> {
+            SMatrix::zeros()
+        }
+        fn restitution(&self) -> SVector<f64, 0> {
+            SVector::zeros()
+        }
+        fn parameter(&self, _: usize) -> Option<f64> {
+            None
+        }
+        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
+            None
+        }
+        fn linearization(
+            &self,
+            t: f64,
+            q: &Vector2<f64>,
+            v: &Vector2<f64>,
+            u: &SVector<f64, 0>,
+        ) -> Linearization<f64, 2> {
+            Linearization {
+                mass: self.mass(q),
+                forces: self.forces(t, q, v, u),
+                forces_dq: Matrix2::zeros(),
+                forces_dv: self.coriolis(q, v) * 2.0,
+            }
+        }
+    }
+
+    /// The sup over unit `(ṙ, θ̇)` of `‖[[0, −θ̇], [θ̇, ṙ]]‖₂`: with
+    /// `y = θ̇²`, `σ² = (1 + y + √(1 + 2y − 3y²))/2`, largest at `y = 2/3`,
+    /// `σ² = 4/3`.
+    const POLAR_SIGMA: f64 = 1.154_700_538_379_251_5; // √(4/3)
+
+    #[test]
+    fn polar_particle_constants_match_their_closed_form() {
+        let model = Polar { m: 2.0 };
+        let (r_min, r_max, c_v) = (0.5, 1.5, 3.0);
+        let region = GainRegion::new(Vector2::new(r_min, -3.0), Vector2::new(r_max, 3.0), c_v);
+        let b = ModelBounds::estimate(&model, &region, &SVector::zeros()).unwrap();
+        // λ(M) = {m, m r²}: the corners attain both extremes exactly
+        assert_eq!(b.mass_min, 2.0 * r_min * r_min);
+        assert_eq!(b.mass_max, 2.0 * r_max * r_max);
+        // C_M = m r_max √(4/3): sampled from below, within 1e-3 with the
+        // default 64 Halton directions
+        let c_m = 2.0 * r_max * POLAR_SIGMA;
+        assert!(b.coriolis <= c_m * (1.0 + 1e-12), "{} > {c_m}", b.coriolis);
+        assert!(b.coriolis >= c_m * (1.0 - 1e-3), "{} vs {c_m}", b.coriolis);
+        // ∂F/∂v = 2C(q, v): C_F = 2 C_M C_v
+        let c_f = 2.0 * c_m * c_v;
+        assert!(b.force_lipschitz <= c_f * (1.0 + 1e-12));
+        assert!(b.force_lipschitz >= c_f * (1.0 - 1e-3));
+        assert_eq!(b.configurations, 4 + 1 + 512);
+        // the corollaries, both ways
+        let l_d = b.gain(Design::ReducedOrder, 1.0);
+        assert!((b.beta(Design::ReducedOrder, l_d) - 1.0).abs() < 1e-12);
+        let l_d = b.gain(Design::FullOrder, 1.0);
+        assert!((b.beta(Design::FullOrder, l_d) - 1.0).abs() < 1e-12);
+        // r = β₂ / λ_min
+        assert!((b.decay_rate(l_d) - 1.0 / b.mass_min).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sampling_is_deterministic_and_in_the_box() {
+        let region = GainRegion::new(Vector2::new(-1.0, 2.0), Vector2::new(1.0, 3.0), 1.0);
+        for i in 0..region.configuration_count() {
+            let q = region.configuration(i);
+            assert!(q[0] >= -1.0 && q[0] <= 1.0 && q[1] >= 2.0 && q[1] <= 3.0);
+        }
+        assert_eq!(region.configuration(4), Vector2::new(0.0, 2.5)); // the centre
+        assert_eq!(radical_inverse(6, 2), 0.375); // 110₂ → 0.011₂
+        for j in 0..2 * 2 + region.directions {
+            if let Some(d) = region.direction(j) {
+                let n: f64 = d.norm();
+                assert!((n - 1.0).abs() < 1e-15);
+            }
+        }
+        let model = Polar { m: 1.0 };
+        let region = GainRegion::new(Vector2::new(0.5, 0.0), Vector2::new(1.0, 1.0), 2.0);
+        let a = ModelBounds::estimate(&model, &region, &SVector::zeros()).unwrap();
+        let b = ModelBounds::estimate(&model, &region, &SVector::zeros()).unwrap();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn a_bad_region_is_an_error() {
+        let model = Polar { m: 1.0 };
+        let u = SVector::zeros();
+        let region = GainRegion::new(Vector2::new(1.0, 0.0), Vector2::new(0.5, 1.0), 2.0);
+        assert!(matches!(
+            ModelBounds::estimate(&model, &region, &u),
+            Err(ObserverError::InvalidParams { name: "q_min", .. })
+        ));
+        let region = GainRegion::new(Vector2::new(0.5, 0.0), Vector2::new(1.0, 1.0), 0.0);
+        assert!(matches!(
+            ModelBounds::estimate(&model, &region, &u),
+            Err(ObserverError::InvalidParams {
+                name: "velocity_bound",
+                ..
+            })
+        ));
+        let region = GainRegion::new(Vector2::new(f64::NAN, 0.0), Vector2::new(1.0, 1.0), 1.0);
+        assert!(ModelBounds::estimate(&model, &region, &u).is_err());
+        // r = 0 makes M singular
+        let region = GainRegion::new(Vector2::new(0.0, 0.0), Vector2::new(1.0, 1.0), 1.0);
+        assert_eq!(
+            ModelBounds::estimate(&model, &region, &u),
+            Err(ObserverError::MassNotPositiveDefinite)
+        );
+    }
+}

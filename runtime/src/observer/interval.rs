@@ -1,0 +1,658 @@
+//! One sampling interval `[t_k, t_{k+1}]` with impacts inside it: the
+//! discretization both observers share (see the module docs of
+//! [`observer`](crate::observer) for the derivation and the contact rule).
+//!
+//! Along the interval the local time is `s ∈ [0, τ]`; the predicted motion
+//! `(p(s), w(s))` starts at the measured `q_k` with the estimate `v̂_k`.
+
+use nalgebra::{RealField, SMatrix, SVector};
+
+use crate::lcp::{IndexSet, Lcp};
+use crate::linalg::Cholesky;
+use crate::model::Model;
+
+use super::{ObserverError, ObserverParams, UpdateReport};
+
+type Result<X, T> = core::result::Result<X, ObserverError<T>>;
+
+/// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
+/// the ball `|v| ≤ C_v`, 1-Lipschitz, so `F̄(t, q, v) = F(t, q, sat(v))` is
+/// the Lipschitz extension of Assumption 1.
+pub(crate) fn saturate<T: RealField + Copy, const N: usize>(
+    v: &SVector<T, N>,
+    bound: T,
+) -> SVector<T, N> {
+    let n = v.norm();
+    if n > bound { v * (bound / n) } else { *v }
+}
+
+/// `1 − e^{−x}` over `τ`, the injection gain that integrates
+/// `ṽ' = −l_d ṽ` exactly over an interval of length `τ` (`→ l_d` as `τ → 0`).
+pub(crate) fn injection_gain<T: RealField + Copy>(l_d: T, tau: T) -> T {
+    -(-(l_d * tau)).exp_m1() / tau
+}
+
+/// Rejects a non-finite matrix, naming the model term.
+pub(crate) fn finite<T: RealField + Copy, const R: usize, const C: usize>(
+    m: &SMatrix<T, R, C>,
+    which: &'static str,
+) -> Result<(), T> {
+    if m.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(ObserverError::NonFiniteModel { which })
+    }
+}
+
+/// Factors `M`, rejecting a non-finite or indefinite one.
+pub(crate) fn factor_mass<T: RealField + Copy, const N: usize>(
+    mass: &SMatrix<T, N, N>,
+) -> Result<Cholesky<T, N>, T> {
+    finite(mass, "M")?;
+    Cholesky::new(mass).ok_or(ObserverError::MassNotPositiveDefinite)
+}
+
+/// The mass matrix factored and the free acceleration `−M⁻¹ F̄` at one
+/// point of the predicted motion.
+#[derive(Clone, Copy)]
+pub(crate) struct Free<T: RealField + Copy, const N: usize> {
+    pub chol: Cholesky<T, N>,
+    pub accel: SVector<T, N>,
+}
+
+/// The end of a piece of predicted motion, and the contact impulse
+/// `∫ λ ds` that acted along it.
+struct Arc<T: RealField + Copy, const N: usize, const K: usize> {
+    p: SVector<T, N>,
+    w: SVector<T, N>,
+    impulse: SVector<T, K>,
+}
+
+/// A piece of predicted motion of length `h`, with its cubic Hermite
+/// interpolant (fourth-order accurate in position) for root finding.
+struct Segment<T: RealField + Copy, const N: usize> {
+    p0: SVector<T, N>,
+    w0: SVector<T, N>,
+    p1: SVector<T, N>,
+    w1: SVector<T, N>,
+    h: T,
+}
+
+impl<T: RealField + Copy, const N: usize> Segment<T, N> {
+    /// Position and velocity at `σ ∈ [0, h]`.
+    fn at(&self, sigma: T) -> (SVector<T, N>, SVector<T, N>) {
+        let one = T::one();
+        let two: T = nalgebra::convert(2.0);
+        let three: T = nalgebra::convert(3.0);
+        let x = sigma / self.h;
+        let (x2, x3) = (x * x, x * x * x);
+        let h00 = two * x3 - three * x2 + one;
+        let h10 = x3 - two * x2 + x;
+        let h01 = -two * x3 + three * x2;
+        let h11 = x3 - x2;
+        let p = self.p0 * h00 + self.w0 * (h10 * self.h) + self.p1 * h01 + self.w1 * (h11 * self.h);
+        let six: T = nalgebra::convert(6.0);
+        let four: T = nalgebra::convert(4.0);
+        let d00 = six * x2 - six * x;
+        let d10 = three * x2 - four * x + one;
+        let d11 = three * x2 - two * x;
+        let v = (self.p0 - self.p1) * (d00 / self.h) + self.w0 * d10 + self.w1 * d11;
+        (p, v)
+    }
+}
+
+/// How each constraint stands at the start of a piece of motion.
+#[derive(Clone, Copy, Default)]
+struct Classes {
+    /// Open (`h_i` above the band): watched for a crossing.
+    free: IndexSet,
+    /// Closed (within the band, or just reached).
+    contact: IndexSet,
+    /// Closed and approaching: Newton's law now.
+    approaching: IndexSet,
+    /// Approaching faster than the resting speed: `ê_i` applies.
+    elastic: IndexSet,
+    /// Closed, normal speed within the resting speed: persistent contact.
+    sliding: IndexSet,
+    /// Closed and separating: watched for a return.
+    departing: IndexSet,
+}
+
+/// What the search along a piece of motion found first: these
+/// constraints close (or, for a departing one that never opened, turn
+/// back) at `at`, relative to the piece's start.
+struct Crossing<T> {
+    at: T,
+    set: IndexSet,
+}
+
+/// One sampling interval: the model, the two measurements around it and
+/// the settings.
+pub(crate) struct Interval<'a, M, T, const N: usize, const K: usize>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    pub model: &'a M,
+    pub u: &'a M::Input,
+    pub params: &'a ObserverParams<T>,
+    pub lcp: &'a Lcp<T>,
+    /// `t_k`.
+    pub t0: T,
+    /// `τ = t_{k+1} − t_k`.
+    pub tau: T,
+    /// The measured `q_k`.
+    pub q0: SVector<T, N>,
+    /// The measured `q_{k+1}`.
+    pub q1: SVector<T, N>,
+    /// The observer's restitution `ê`.
+    pub restitution: SVector<T, K>,
+    /// How well the estimate knows the velocity: the correction the last
+    /// update's innovation made, `|d_k| (1 − e^{−l_d τ_k}) / τ_k` (0 before
+    /// the first update). A closed constraint approaching slower than that
+    /// cannot be told from a resting one.
+    pub uncertainty: T,
+}
+
+impl<M, T, const N: usize, const K: usize> Interval<'_, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    /// Newton's law, `ê` on `elastic` and `0` on the rest of `set`, at
+    /// local time `s` (where `J` and `M` were evaluated) for the
+    /// pre-impact velocity `w`: returns `w⁺`.
+    #[allow(clippy::too_many_arguments)]
+    fn newton(
+        &self,
+        s: T,
+        w: &SVector<T, N>,
+        jac: &SMatrix<T, K, N>,
+        chol: &Cholesky<T, N>,
+        set: IndexSet,
+        elastic: IndexSet,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, T> {
+        let jw = jac * w;
+        let mut approach = SVector::<T, K>::zeros();
+        for i in elastic {
+            approach[i] = self.restitution[i] * jw[i];
+        }
+        let before = report.impulses;
+        let dv = self.impulse(jac, chol, w, &approach, set, report)?;
+        // an impact when an elastic (fast) approach received an impulse; a
+        // plastic closure of a resting contact is a contact
+        if elastic.iter().any(|i| report.impulses[i] > before[i]) {
+            report.impacts += 1;
+            if report.first_impact.is_none() {
+                report.first_impact = Some(self.t0 + s);
+            }
+        } else {
+            report.contacts = report.contacts.union(set);
+        }
+        Ok(w + dv)
+    }
+
+    /// Solves `0 ≤ λ ⊥ J (w_free + M⁻¹Jᵀλ) + approach ≥ 0` on `set` and
+    /// returns `M⁻¹Jᵀλ`; records `λ` as impulses.
+    pub fn impulse(
+        &self,
+        jac: &SMatrix<T, K, N>,
+        chol: &Cholesky<T, N>,
+        w_free: &SVector<T, N>,
+        approach: &SVector<T, K>,
+        set: IndexSet,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, T> {
+        if set.is_empty() {
+            return Ok(SVector::zeros());
+        }
+        let minv_jt = chol.solve(&jac.transpose());
+        let delassus = jac * minv_jt;
+        let half: T = nalgebra::convert(0.5);
+        let delassus = (delassus + delassus.transpose()) * half;
+        let b = jac * w_free + approach;
+        let solution = self.lcp.solve(&delassus, &b, set)?;
+        report.lcp_solves += 1;
+        report.lcp_trials += solution.trials;
+        report.lcp_residual = report.lcp_residual.max(solution.residual);
+        report.active = report.active.union(set);
+        for i in set {
+            if solution.lambda[i] > T::zero() {
+                report.impacted.insert(i);
+            }
+        }
+        report.impulses += solution.lambda;
+        Ok(minv_jt * solution.lambda)
+    }
+
+    /// `M` factored and `−M⁻¹ F̄(t_k + s, p, w)`.
+    pub fn free(
+        &self,
+        s: T,
+        p: &SVector<T, N>,
+        w: &SVector<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<Free<T, N>, T> {
+        let w_bar = saturate(w, self.params.velocity_bound);
+        let (mass, forces) = self.model.dynamics(self.t0 + s, p, &w_bar, self.u);
+        report.evaluations += 1;
+        finite(&forces, "F")?;
+        let chol = factor_mass(&mass)?;
+        let accel = -chol.solve(&forces);
+        Ok(Free { chol, accel })
+    }
+
+    /// `(h(p), J(p))`, checked.
+    pub fn contact(&self, p: &SVector<T, N>) -> Result<(SVector<T, K>, SMatrix<T, K, N>), T> {
+        let (h, jac) = self.model.contact(p);
+        finite(&h, "h")?;
+        finite(&jac, "J")?;
+        Ok((h, jac))
+    }
+
+    /// `J̇ w = (∂J/∂q · w) w` by a central difference along `w`:
+    /// `|w| (J(p + δŵ) − J(p − δŵ)) w / (2δ)` with `δ = ε^⅓ max(1, |p|∞)`,
+    /// the step that balances truncation `O(δ²)` and round-off `O(ε/δ)`
+    /// (both about `ε^⅔ ≈ 4e-11` relative in `f64`; exact for the gaps of
+    /// degree two, whose `J` is affine).
+    fn jacobian_rate(&self, p: &SVector<T, N>, w: &SVector<T, N>) -> Result<SVector<T, K>, T> {
+        let n = w.norm();
+        if n == T::zero() {
+            return Ok(SVector::zeros());
+        }
+        let delta = T::default_epsilon().cbrt() * p.amax().max(T::one());
+        let d = w / n;
+        let plus = self.model.gap_jacobian(&(p + d * delta));
+        let minus = self.model.gap_jacobian(&(p - d * delta));
+        finite(&plus, "J")?;
+        finite(&minus, "J")?;
+        Ok((plus - minus) * w * (n / (delta + delta)))
+    }
+
+    /// The acceleration with the persistent contacts `sliding` held by
+    /// their acceleration-level law `0 ≤ λ ⊥ J a + J̇ w ≥ 0`,
+    /// `a = −M⁻¹F̄ + M⁻¹Jᵀλ`; returns `(a, λ)`.
+    fn constrained(
+        &self,
+        p: &SVector<T, N>,
+        w: &SVector<T, N>,
+        sliding: IndexSet,
+        free: &Free<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<(SVector<T, N>, SVector<T, K>), T> {
+        if sliding.is_empty() {
+            return Ok((free.accel, SVector::zeros()));
+        }
+        let jac = self.model.gap_jacobian(p);
+        finite(&jac, "J")?;
+        let rate = self.jacobian_rate(p, w)?;
+        let minv_jt = free.chol.solve(&jac.transpose());
+        let delassus = jac * minv_jt;
+        let half: T = nalgebra::convert(0.5);
+        let delassus = (delassus + delassus.transpose()) * half;
+        let b = jac * free.accel + rate;
+        let solution = self.lcp.solve(&delassus, &b, sliding)?;
+        report.lcp_solves += 1;
+        report.lcp_trials += solution.trials;
+        report.lcp_residual = report.lcp_residual.max(solution.residual);
+        report.active = report.active.union(sliding);
+        Ok((free.accel + minv_jt * solution.lambda, solution.lambda))
+    }
+
+    /// Classical fourth-order Runge–Kutta for `p' = w`, `w' = a(s, p, w)`
+    /// over `[s0, s0 + h]`, from the point whose free acceleration is
+    /// `first`.
+    #[allow(clippy::too_many_arguments)]
+    fn rk4(
+        &self,
+        s0: T,
+        p0: &SVector<T, N>,
+        w0: &SVector<T, N>,
+        h: T,
+        sliding: IndexSet,
+        first: &Free<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<Arc<T, N, K>, T> {
+        let half = h * nalgebra::convert::<f64, T>(0.5);
+        let two: T = nalgebra::convert(2.0);
+        let (k1, l1) = self.constrained(p0, w0, sliding, first, report)?;
+        let (p2, w2) = (p0 + w0 * half, w0 + k1 * half);
+        let f2 = self.free(s0 + half, &p2, &w2, report)?;
+        let (k2, l2) = self.constrained(&p2, &w2, sliding, &f2, report)?;
+        let (p3, w3) = (p0 + w2 * half, w0 + k2 * half);
+        let f3 = self.free(s0 + half, &p3, &w3, report)?;
+        let (k3, l3) = self.constrained(&p3, &w3, sliding, &f3, report)?;
+        let (p4, w4) = (p0 + w3 * h, w0 + k3 * h);
+        let f4 = self.free(s0 + h, &p4, &w4, report)?;
+        let (k4, l4) = self.constrained(&p4, &w4, sliding, &f4, report)?;
+        let sixth = h / nalgebra::convert(6.0);
+        Ok(Arc {
+            p: p0 + (w0 + w2 * two + w3 * two + w4) * sixth,
+            w: w0 + (k1 + k2 * two + k3 * two + k4) * sixth,
+            impulse: (l1 + l2 * two + l3 * two + l4) * sixth,
+        })
+    }
+
+    /// The velocity scale of measurement noise in the estimate,
+    /// `n_σ √2 σ (1 − e^{−l_d τ})/τ`: the injection passes the noise of two
+    /// samples with the gain of one interval.
+    fn noise_speed(&self) -> T {
+        let p = self.params;
+        p.noise_sigmas
+            * p.noise
+            * nalgebra::convert::<f64, T>(core::f64::consts::SQRT_2)
+            * injection_gain(p.l_d, self.tau)
+    }
+
+    /// Sorts the constraints at a point `(p, w)` of the predicted motion
+    /// (the contact rule of the module docs).
+    ///
+    /// With `g_i = |∇h_i|`, the band `b_i = g_i (d + n_σ σ)`, the normal
+    /// acceleration of the free motion relative to the constraint
+    /// `A_i = |J_i a + J̇_i w|` and the velocity noise `ν = n_σ √2 σ φ_l`,
+    /// the resting speed is
+    ///
+    /// `v_rest,i = ρ τ A_i + √(4 A_i b_i) + g_i ν + 64 ε g_i |w|`:
+    ///
+    /// what the forces build over `ρτ`, what a fall through twice the band
+    /// builds (a sample that noise puts outside the band falls back in that
+    /// fast, and is no impact), the noise of the estimate, round-off. A
+    /// closed constraint approaching faster than that while its gap is
+    /// still positive is left open, so that the root of its gap along the
+    /// predicted motion times the impact. A closed constraint gets its
+    /// restitution only when it approaches faster than
+    /// `v_rest,i + g_i u`, with `u` the estimate's [`uncertainty`](Self::uncertainty):
+    /// slower, it is closed plastically.
+    #[allow(clippy::too_many_arguments)]
+    fn classify(
+        &self,
+        p: &SVector<T, N>,
+        h: &SVector<T, K>,
+        jac: &SMatrix<T, K, N>,
+        w: &SVector<T, N>,
+        accel: &SVector<T, N>,
+        resolved: IndexSet,
+        touched: IndexSet,
+    ) -> Result<Classes, T> {
+        let mut c = Classes::default();
+        let band = self.params.contact_band();
+        let noise_speed = self.noise_speed();
+        let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
+        let four: T = nalgebra::convert(4.0);
+        let mut closed = IndexSet::EMPTY;
+        for i in 0..K.min(IndexSet::CAPACITY) {
+            let g = jac.row(i).norm();
+            if h[i] <= g * band || touched.contains(i) {
+                closed.insert(i);
+            } else {
+                c.free.insert(i);
+            }
+        }
+        if closed.is_empty() {
+            return Ok(c);
+        }
+        let rate = self.jacobian_rate(p, w)?;
+        for i in closed {
+            let row = jac.row(i);
+            let g = row.norm();
+            let jw = row.dot(&w.transpose());
+            let normal_accel = (row.dot(&accel.transpose()) + rate[i]).abs();
+            let floor = roundoff * g;
+            let rest = self.params.rest_factor * self.tau * normal_accel
+                + (four * normal_accel * g * band).sqrt()
+                + g * noise_speed
+                + floor;
+            if jw < -rest && h[i] > T::zero() && !touched.contains(i) {
+                // a fast approach still outside: its root along the
+                // predicted motion says when it closes (the band only
+                // says that it is near)
+                c.free.insert(i);
+                continue;
+            }
+            c.contact.insert(i);
+            if jw < -floor && !resolved.contains(i) {
+                c.approaching.insert(i);
+                // restitution only for an approach the estimate can tell
+                // from rest: a closed pair that travels together (glued
+                // balls) must not bounce on the round-off of its estimate,
+                // or a later simultaneous impact is resolved as a sequence
+                if jw < -(rest + g * self.uncertainty) {
+                    c.elastic.insert(i);
+                }
+            } else if jw <= rest {
+                c.sliding.insert(i);
+            } else {
+                c.departing.insert(i);
+            }
+        }
+        Ok(c)
+    }
+
+    /// `h_i` along the segment at `σ`.
+    fn gap_at(&self, seg: &Segment<T, N>, i: usize, sigma: T) -> Result<T, T> {
+        let (p, _) = seg.at(sigma);
+        let h = self.model.gaps(&p);
+        finite(&h, "h")?;
+        Ok(h[i])
+    }
+
+    /// Root of `h_i` along the segment in `[a, b]`, `f(a) > 0 ≥ f(b)`, by
+    /// the Illinois variant of regula falsi; returns a point with
+    /// `f ≤ 0` within `1024 ε τ` of the root.
+    fn root(&self, seg: &Segment<T, N>, i: usize, bracket: [(T, T); 2]) -> Result<T, T> {
+        let [(mut a, mut fa), (mut b, mut fb)] = bracket;
+        let tol = T::default_epsilon() * nalgebra::convert(1024.0) * self.tau;
+        let half: T = nalgebra::convert(0.5);
+        let mut last = 0i8;
+        for _ in 0..128 {
+            if b - a <= tol || fb == T::zero() {
+                break;
+            }
+            let mut c = (a * fb - b * fa) / (fb - fa);
+            if !(c > a && c < b) {
+                c = (a + b) * half;
+            }
+            let fc = self.gap_at(seg, i, c)?;
+            if fc > T::zero() {
+                (a, fa) = (c, fc);
+                if last == -1 {
+                    fb *= half;
+                }
+                last = -1;
+            } else {
+                (b, fb) = (c, fc);
+                if last == 1 {
+                    fa *= half;
+                }
+                last = 1;
+            }
+        }
+        Ok(b)
+    }
+
+    /// The extremum of `h_i` along the segment in `[a, b]`, where its rate
+    /// `∇h_i · p'` changes sign, by bisection; returns `(σ, h_i(σ))`.
+    fn extremum(&self, seg: &Segment<T, N>, i: usize, mut a: T, mut b: T) -> Result<(T, T), T> {
+        let half: T = nalgebra::convert(0.5);
+        let tol = T::default_epsilon().sqrt() * self.tau;
+        let rate = |sigma: T| -> Result<T, T> {
+            let (p, v) = seg.at(sigma);
+            let jac = self.model.gap_jacobian(&p);
+            finite(&jac, "J")?;
+            Ok(jac.row(i).dot(&v.transpose()))
+        };
+        let falling_at_a = rate(a)? < T::zero();
+        for _ in 0..64 {
+            if b - a <= tol {
+                break;
+            }
+            let m = (a + b) * half;
+            if (rate(m)? < T::zero()) == falling_at_a {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        let m = (a + b) * half;
+        Ok((m, self.gap_at(seg, i, m)?))
+    }
+
+    /// The first constraint to close along the segment (see the module
+    /// docs: an open gap that ends closed, an open gap that dips below zero
+    /// and reopens, a separating contact that comes back; `bands` are the
+    /// contact bands `g_i b` at the segment's start).
+    fn first_crossing(
+        &self,
+        seg: &Segment<T, N>,
+        c: &Classes,
+        bands: &SVector<T, K>,
+        start: (&SVector<T, K>, &SVector<T, K>),
+        end: (&SVector<T, K>, &SVector<T, K>),
+    ) -> Result<Option<Crossing<T>>, T> {
+        let (h0, rate0) = start;
+        let (h1, rate1) = end;
+        let zero = T::zero();
+        let mut best: Option<(T, IndexSet)> = None;
+        let tol = T::default_epsilon() * nalgebra::convert(1024.0) * self.tau;
+        let mut record = |at: T, i: usize| match &mut best {
+            Some((s, set)) if (at - *s).abs() <= tol => {
+                set.insert(i);
+            }
+            Some((s, _)) if at > *s => {}
+            _ => {
+                let mut set = IndexSet::new();
+                set.insert(i);
+                best = Some((at, set));
+            }
+        };
+        for i in c.free {
+            if h1[i] <= zero {
+                record(self.root(seg, i, [(zero, h0[i]), (seg.h, h1[i])])?, i);
+            } else if rate0[i] < zero && rate1[i] > zero {
+                let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
+                if fm <= zero {
+                    record(self.root(seg, i, [(zero, h0[i]), (m, fm)])?, i);
+                }
+            }
+        }
+        for i in c.departing {
+            if h1[i] <= zero && rate1[i] < zero {
+                // it turns back: past the band it opened, and closes again
+                // at a root; within the band it never opened, and from its
+                // turning point (normal speed zero) it is a persistent
+                // contact
+                let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
+                if fm > bands[i] {
+                    record(self.root(seg, i, [(m, fm), (seg.h, h1[i])])?, i);
+                } else {
+                    record(m, i);
+                }
+            }
+        }
+        Ok(best.map(|(at, set)| Crossing { at, set }))
+    }
+
+    /// The predicted motion over the whole interval from `(q_k, v̂_k)`, with
+    /// every impact located inside it: returns the predicted end
+    /// `(p(τ), w(τ⁻))`.
+    pub fn predict(
+        &self,
+        v0: &SVector<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<(SVector<T, N>, SVector<T, N>), T> {
+        let max_impacts = self.params.max_impacts;
+        let max_rounds = max_impacts.saturating_mul(2).saturating_add(8);
+        let (mut s, mut p, mut w) = (T::zero(), self.q0, *v0);
+        // constraints that met Newton's law at this point (no second law
+        // here), and reached by a root at this point (closed whatever the
+        // sign of their gap)
+        let mut resolved = IndexSet::EMPTY;
+        let mut touched = IndexSet::EMPTY;
+        let mut round = 0;
+        loop {
+            round += 1;
+            let last_round = round >= max_rounds;
+            // CLASSIFY at (s, p, w)
+            let free = self.free(s, &p, &w, report)?;
+            let (h, jac) = self.contact(&p)?;
+            let c = self.classify(&p, &h, &jac, &w, &free.accel, resolved, touched)?;
+            // IMPACT now, on the closed constraints met approaching
+            if !c.approaching.is_empty() && !last_round {
+                let elastic = if report.impacts < max_impacts {
+                    c.elastic
+                } else {
+                    IndexSet::EMPTY
+                };
+                w = self.newton(s, &w, &jac, &free.chol, c.contact, elastic, report)?;
+                resolved = resolved.union(c.approaching);
+                touched = touched.union(c.approaching);
+                continue;
+            }
+            // FLIGHT (and sliding) to the end of the interval
+            let rest = self.tau - s;
+            if rest <= T::zero() {
+                return Ok((p, w));
+            }
+            let arc = self.rk4(s, &p, &w, rest, c.sliding, &free, report)?;
+            report.contacts = report.contacts.union(c.sliding);
+            // SEARCH for the first closing constraint along it
+            if !last_round && report.impacts < max_impacts {
+                let (h1, jac1) = self.contact(&arc.p)?;
+                let seg = Segment {
+                    p0: p,
+                    w0: w,
+                    p1: arc.p,
+                    w1: arc.w,
+                    h: rest,
+                };
+                let rate0 = jac * w;
+                let rate1 = jac1 * arc.w;
+                let band = self.params.contact_band();
+                let bands = SVector::<T, K>::from_fn(|i, _| jac.row(i).norm() * band);
+                if let Some(Crossing { at, set }) =
+                    self.first_crossing(&seg, &c, &bands, (&h, &rate0), (&h1, &rate1))?
+                {
+                    let part = self.rk4(s, &p, &w, at, c.sliding, &free, report)?;
+                    report.impulses += part.impulse;
+                    (s, p, w) = (s + at, part.p, part.w);
+                    (resolved, touched) = (IndexSet::EMPTY, set);
+                    continue;
+                }
+            }
+            report.impulses += arc.impulse;
+            return Ok((arc.p, arc.w));
+        }
+    }
+
+    /// Newton's law at the end of the interval, at the measured `q_{k+1}`,
+    /// for the closed constraints the estimate `v` approaches: the
+    /// estimate leaves every update with `v̂_e ∈ V(q_{k+1})`, as (20) asks.
+    pub fn close_at_end(
+        &self,
+        v: &SVector<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, T> {
+        let (h, jac) = self.contact(&self.q1)?;
+        let band = self.params.contact_band();
+        let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * v.norm();
+        let approaching = (0..K.min(IndexSet::CAPACITY)).any(|i| {
+            let row = jac.row(i);
+            h[i] <= row.norm() * band && row.dot(&v.transpose()) < -roundoff * row.norm()
+        });
+        if !approaching {
+            return Ok(*v);
+        }
+        let free = self.free(self.tau, &self.q1, v, report)?;
+        let c = self.classify(
+            &self.q1,
+            &h,
+            &jac,
+            v,
+            &free.accel,
+            IndexSet::EMPTY,
+            IndexSet::EMPTY,
+        )?;
+        self.newton(self.tau, v, &jac, &free.chol, c.contact, c.elastic, report)
+    }
+}

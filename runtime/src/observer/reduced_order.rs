@@ -1,0 +1,603 @@
+//! The reduced-order observer (38), in the convergent form its Corollary 3
+//! needs.
+
+use nalgebra::{RealField, SVector};
+
+use crate::lcp::{IndexSet, Lcp};
+use crate::model::Model;
+
+use super::interval::{Interval, factor_mass, finite, injection_gain, saturate};
+use super::{
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
+    check_restitution, check_update, check_vector,
+};
+
+/// The reduced-order velocity observer (38): `q̂ = q`, and
+///
+/// $$\hat v = z + l_d q,\qquad M(q)\,dz + \bar F(t, q, \hat v)\,dt + l_d M(q)\,\hat v\,dt \in -N_{V(q)}(\hat v_e),$$
+///
+/// so that `M dv̂ = −F̄ dt + l_d M (v − v̂) dt − η̂` and the error obeys
+/// `M dṽ = −(F − F̄) dt − l_d M ṽ dt − (η − η̂)` (the printed signs of (38)
+/// give `+ l_d M ṽ dt`: see the module docs of
+/// `runtime/src/observer/mod.rs`).
+///
+/// The state is `(t_k, q_k, v̂_k)`, fixed-size, on the stack; an update
+/// allocates nothing.
+///
+/// ```
+/// use moreau_runtime::{Model, ModelInfo, Observer, ObserverParams, ReducedOrder};
+/// use nalgebra::{Matrix1, SVector, Vector1};
+///
+/// /// A unit ball above the floor y = 0.
+/// struct Ball;
+/// impl Model<1, 1> for Ball {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 1> = ModelInfo {
+///         name: "Ball", coordinates: ["y"], velocities: ["vy"], constraints: ["floor"],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> { Vector1::new(9.81) }
+///     fn forces(&self, _: f64, q: &Vector1<f64>, _: &Vector1<f64>, _: &SVector<f64, 0>) -> Vector1<f64> {
+///         self.gravity(q)
+///     }
+///     fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> { *q }
+///     fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn restitution(&self) -> Vector1<f64> { Vector1::new(0.5) }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+/// }
+///
+/// // the ball falls from y = 2 at rest; the observer starts believing it
+/// // rises at 1 m/s and sees only the exact positions y(t) = 2 − g t²/2
+/// let y = |t: f64| 2.0 - 0.5 * 9.81 * t * t;
+/// let params = ObserverParams::new(10.0, 20.0);
+/// let mut observer = ReducedOrder::<f64, 1, 1>::new(params, 0.0, Vector1::new(2.0), Vector1::new(1.0))?;
+/// for k in 1..=300 {
+///     let t = k as f64 * 1e-3;
+///     observer.update(&Ball, t, &Vector1::new(y(t)), &SVector::zeros())?;
+/// }
+/// // the error decays like e^{-l_d t}: 1 m/s · e^{-3} = 0.05 m/s after 0.3 s
+/// let error = observer.estimate().v[0] - (-9.81 * 0.3);
+/// assert!((error - (-3.0_f64).exp()).abs() < 1e-9);
+/// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReducedOrder<T: RealField + Copy, const N: usize, const K: usize> {
+    params: ObserverParams<T>,
+    restitution: Option<SVector<T, K>>,
+    lcp: Lcp<T>,
+    t: T,
+    q: SVector<T, N>,
+    v: SVector<T, N>,
+    report: UpdateReport<T, N, K>,
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
+    /// An observer with these settings, started at time `t0` from the first
+    /// measurement `q0` and the initial velocity estimate `v0`.
+    ///
+    /// # Errors
+    ///
+    /// [`ObserverError::InvalidParams`] for a setting out of its range,
+    /// [`ObserverError::NonFiniteMeasurement`] (`"q0"`, `"v0"`) or
+    /// [`ObserverError::InvalidTime`] for non-finite initial data.
+    pub fn new(
+        params: ObserverParams<T>,
+        t0: T,
+        q0: SVector<T, N>,
+        v0: SVector<T, N>,
+    ) -> Result<Self, ObserverError<T>> {
+        params.check()?;
+        if !t0.is_finite() {
+            return Err(ObserverError::InvalidTime { t: t0, last: t0 });
+        }
+        check_vector(&q0, "q0")?;
+        check_vector(&v0, "v0")?;
+        Ok(Self {
+            params,
+            restitution: None,
+            lcp: Lcp::default(),
+            t: t0,
+            q: q0,
+            v: v0,
+            report: UpdateReport::new(t0, T::zero()),
+        })
+    }
+
+    /// The same observer with its own restitution coefficients `ê`
+    /// (Section VI-D) instead of the model's.
+    ///
+    /// # Errors
+    ///
+    /// [`ObserverError::InvalidRestitution`] for a coefficient outside
+    /// `[0, 1]`.
+    pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, ObserverError<T>> {
+        check_restitution(&restitution)?;
+        Ok(Self {
+            restitution: Some(restitution),
+            ..self
+        })
+    }
+
+    /// The observer's restitution `ê`: its own, or `None` for the model's.
+    pub fn restitution(&self) -> Option<SVector<T, K>> {
+        self.restitution
+    }
+
+    /// The observer state `z = v̂ − l_d q` of (38).
+    pub fn z(&self) -> SVector<T, N> {
+        self.v - self.q * self.params.l_d
+    }
+
+    /// The plain Section VII step: `z_{k+1} = z_k − τ M(q_{k+1})⁻¹ (F̄ +
+    /// l_d M v̂')` with `v̂' = z_k + l_d q_{k+1}`, then the LCP (41) at
+    /// `q_{k+1}` on the constraints whose sampled gap is closed.
+    fn section_vii<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, ObserverError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let (l_d, tau) = (self.params.l_d, interval.tau);
+        let q1 = &interval.q1;
+        let v_pre = self.v + (q1 - self.q) * l_d;
+        let (mass, forces) = interval.model.dynamics(
+            interval.t0 + tau,
+            q1,
+            &saturate(&v_pre, self.params.velocity_bound),
+            interval.u,
+        );
+        report.evaluations += 1;
+        finite(&forces, "F")?;
+        let chol = factor_mass(&mass)?;
+        let v_free = v_pre - chol.solve(&forces) * tau - v_pre * (tau * l_d);
+        report.innovation = q1 - self.q - self.v * tau;
+        section_vii_impact(interval, &chol, &self.v, &v_free, report)
+    }
+}
+
+/// The LCP (41) of the Section VII scheme at `q_{k+1}`: the constraints
+/// whose gap is closed at `q_k` or at `q_{k+1}`, Newton's law
+/// `0 ≤ λ ⊥ J(q_{k+1})(v̂_{k+1} + ê v̂_k) ≥ 0`, `v̂_{k+1} = v_free + M⁻¹Jᵀλ`.
+pub(crate) fn section_vii_impact<M, T, const N: usize, const K: usize>(
+    interval: &Interval<'_, M, T, N, K>,
+    chol: &crate::linalg::Cholesky<T, N>,
+    v_before: &SVector<T, N>,
+    v_free: &SVector<T, N>,
+    report: &mut UpdateReport<T, N, K>,
+) -> Result<SVector<T, N>, ObserverError<T>>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    let (h0, jac0) = interval.contact(&interval.q0)?;
+    let (h1, jac) = interval.contact(&interval.q1)?;
+    let band = interval.params.contact_band();
+    let mut set = IndexSet::new();
+    for i in 0..K.min(IndexSet::CAPACITY) {
+        let g = jac.row(i).norm() * band;
+        if h0[i] <= g || h1[i] <= g {
+            set.insert(i);
+        }
+    }
+    // Newton's law measures the approach as the plant stepper's default
+    // does: the slower of J(q_k) v̂_k and J(q_{k+1}) v̂_k (the latter alone
+    // kicks an estimate sliding on a curved constraint off it, every step)
+    let approach_velocity = (jac0 * v_before).sup(&(jac * v_before));
+    let approach = interval.restitution.component_mul(&approach_velocity);
+    let before = report.impulses;
+    let dv = interval.impulse(&jac, chol, v_free, &approach, set, report)?;
+    if report.impulses != before {
+        report.impacts = 1;
+        report.first_impact = Some(interval.t0 + interval.tau);
+    }
+    Ok(v_free + dv)
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
+    for ReducedOrder<T, N, K>
+{
+    fn update<M>(
+        &mut self,
+        model: &M,
+        t: T,
+        q: &SVector<T, N>,
+        u: &M::Input,
+    ) -> Result<Estimate<T, N>, ObserverError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let tau = check_update(model, self.t, t, q, u)?;
+        let restitution = self.restitution.unwrap_or_else(|| model.restitution());
+        check_restitution(&restitution)?;
+        let interval = Interval {
+            model,
+            u,
+            params: &self.params,
+            lcp: &self.lcp,
+            t0: self.t,
+            tau,
+            q0: self.q,
+            q1: *q,
+            restitution,
+            uncertainty: self.report.uncertainty(self.params.l_d),
+        };
+        let mut report = UpdateReport::new(t, tau);
+        let v = match self.params.scheme {
+            Discretization::ImpactAware => {
+                // PREDICT from (q_k, v̂_k), impacts inside the interval
+                let (p_end, w_end) = interval.predict(&self.v, &mut report)?;
+                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
+                // displacement, integrated exactly over τ
+                let innovation = q - p_end;
+                report.innovation = innovation;
+                let v = w_end + innovation * injection_gain(self.params.l_d, tau);
+                // CLOSE: v̂_e ∈ V(q_{k+1})
+                interval.close_at_end(&v, &mut report)?
+            }
+            Discretization::SectionVii => self.section_vii(&interval, &mut report)?,
+        };
+        // WRITEBACK: only a finite estimate replaces the state
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(ObserverError::NonFiniteResult);
+        }
+        (self.t, self.q, self.v, self.report) = (t, *q, v, report);
+        Ok(self.estimate())
+    }
+
+    fn estimate(&self) -> Estimate<T, N> {
+        Estimate {
+            t: self.t,
+            q: self.q,
+            v: self.v,
+        }
+    }
+
+    fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
+    fn params(&self) -> &ObserverParams<T> {
+        &self.params
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::ModelInfo;
+    use nalgebra::{Matrix1, Matrix2, SMatrix, Vector1, Vector2};
+
+    /// A ball of unit mass above the floor `y ≥ 0`, gravity `g`,
+    /// restitution `e`.
+    struct Ball {
+        g: f64,
+        e: f64,
+    }
+
+    impl Model<1, 1> for Ball {
+        type Scalar = f64;
+        type Input = SVector<f64, 0>;
+        const INFO: ModelInfo<1, 1> = ModelInfo {
+            name: "Ball",
+            coordinates: ["y"],
+            velocities: ["vy"],
+            constraints: ["floor"],
+            parameters: &[],
+            inputs: &[],
+            source: "",
+            op_count: 0,
+        };
+        fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> {
+            Matrix1::new(1.0)
+        }
+        fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> {
+            Matrix1::zeros()
+        }
+        fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> {
+            Vector1::new(self.g)
+        }
+        fn forces(
+            &self,
+            _: f64,
+            q: &Vector1<f64>,
+            _: &Vector1<f64>,
+            _: &SVector<f64, 0>,
+        ) -> Vector1<f64> {
+            self.gravity(q)
+        }
+        fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> {
+            *q
+        }
+        fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> {
+            Matrix1::new(1.0)
+        }
+        fn restitution(&self) -> Vector1<f64> {
+            Vector1::new(self.e)
+        }
+        fn parameter(&self, _: usize) -> Option<f64> {
+            None
+        }
+        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
+            None
+        }
+    }
+
+    /// The exact bouncing ball dropped from rest at `y0`: `(y, v)` at `t`
+    /// (right limits), and the impact times.
+    fn exact_ball(g: f64, e: f64, y0: f64, t: f64) -> (f64, f64, Vec<f64>) {
+        let mut impacts = Vec::new();
+        let mut t_impact = (2.0 * y0 / g).sqrt();
+        if t < t_impact {
+            return (y0 - 0.5 * g * t * t, -g * t, impacts);
+        }
+        let mut up = e * g * t_impact;
+        loop {
+            impacts.push(t_impact);
+            let flight = 2.0 * up / g;
+            if t < t_impact + flight {
+                let s = t - t_impact;
+                return (up * s - 0.5 * g * s * s, up - g * s, impacts);
+            }
+            t_impact += flight;
+            up *= e;
+        }
+    }
+
+    /// On exact samples of a bouncing ball (analytic, not made by any time
+    /// stepper) with the exact initial velocity, the impact-aware observer
+    /// locates each bounce inside its sampling interval and keeps the
+    /// velocity exact to round-off; Section VII, whose sampled gaps are
+    /// positive around each bounce, misses it by the whole jump.
+    #[test]
+    fn bounces_between_samples_are_located() {
+        let ball = Ball { g: 9.81, e: 0.8 };
+        let (y0, tau) = (1.0, 1e-3);
+        let u = SVector::zeros();
+        let params = ObserverParams::new(10.0, 20.0);
+        let mut aware =
+            ReducedOrder::<f64, 1, 1>::new(params, 0.0, Vector1::new(y0), Vector1::zeros())
+                .unwrap();
+        let plain_params = params.with_scheme(Discretization::SectionVii);
+        let mut plain =
+            ReducedOrder::<f64, 1, 1>::new(plain_params, 0.0, Vector1::new(y0), Vector1::zeros())
+                .unwrap();
+        let (mut worst, mut located, mut plain_worst) = (0.0_f64, Vec::new(), 0.0_f64);
+        for k in 1..=2000 {
+            let t = k as f64 * tau;
+            let (y, v, _) = exact_ball(ball.g, ball.e, y0, t);
+            let estimate = aware.update(&ball, t, &Vector1::new(y), &u).unwrap();
+            worst = worst.max((estimate.v[0] - v).abs());
+            if let Some(at) = aware.report().first_impact {
+                located.push(at);
+            }
+            let estimate = plain.update(&ball, t, &Vector1::new(y), &u).unwrap();
+            plain_worst = plain_worst.max((estimate.v[0] - v).abs());
+        }
+        let (_, _, impacts) = exact_ball(ball.g, ball.e, y0, 2.0);
+        assert_eq!(located.len(), impacts.len());
+        for (a, b) in located.iter().zip(&impacts) {
+            assert!((a - b).abs() < 1e-12, "impact at {a}, exact {b}");
+        }
+        assert!(worst < 1e-10, "{worst}");
+        // the first bounce (4.4 m/s) is missed: both gaps around it open
+        assert!(plain_worst > 4.0, "{plain_worst}");
+    }
+
+    /// The ball dropped with `e = 0.5` comes to rest after an accumulation
+    /// of bounces; the observer follows it (Newton's law for the resolved
+    /// bounces, a plastic closure below the resting speed) and ends at
+    /// rest in persistent contact, locating no impact there. What the
+    /// merged bounces left (below the resting speed `ρ τ g ≈ 1e-3`) decays
+    /// like `e^{−l_d t}`: below `1e-3 e^{−5} = 7e-6` half a second later.
+    #[test]
+    fn an_accumulation_ends_in_persistent_contact() {
+        let ball = Ball { g: 9.81, e: 0.5 };
+        let (y0, tau) = (0.5, 1e-3);
+        let u = SVector::zeros();
+        let params = ObserverParams::new(10.0, 20.0);
+        let mut observer =
+            ReducedOrder::<f64, 1, 1>::new(params, 0.0, Vector1::new(y0), Vector1::zeros())
+                .unwrap();
+        // accumulation at t = t1 (1 + 2e/(1 − e)) = 3 t1 for e = 1/2
+        let t_rest = 3.0 * (2.0 * y0 / ball.g).sqrt();
+        for k in 1..=1500 {
+            let t = k as f64 * tau;
+            let y = if t < t_rest {
+                exact_ball(ball.g, ball.e, y0, t).0
+            } else {
+                0.0
+            };
+            observer.update(&ball, t, &Vector1::new(y), &u).unwrap();
+            if t > t_rest + 0.05 {
+                assert_eq!(observer.report().impacts, 0);
+                assert!(observer.report().contacts.contains(0));
+            }
+            if t > t_rest + 0.5 {
+                assert!(
+                    observer.estimate().v[0].abs() < 7e-6,
+                    "{}",
+                    observer.estimate().v[0]
+                );
+            }
+        }
+    }
+
+    /// Noisy samples of a ball at rest on the floor: the contact rule keeps
+    /// the noise from opening the contact or triggering impacts, and the
+    /// estimate's error settles near `l_d σ`.
+    #[test]
+    fn noise_does_not_trigger_impacts_at_rest() {
+        let ball = Ball { g: 9.81, e: 0.9 };
+        let sigma = 1e-3;
+        let u = SVector::zeros();
+        let params = ObserverParams::new(10.0, 20.0).with_noise(sigma);
+        let mut observer =
+            ReducedOrder::<f64, 1, 1>::new(params, 0.0, Vector1::zeros(), Vector1::zeros())
+                .unwrap();
+        // a deterministic ±σ√3 uniform sequence (standard deviation σ)
+        let mut x = 0.3_f64;
+        let mut sum_sq = 0.0;
+        for k in 1..=4000 {
+            x = (x * 9.73 + 0.31).fract();
+            let y = sigma * 3f64.sqrt() * (2.0 * x - 1.0);
+            let estimate = observer
+                .update(&ball, k as f64 * 1e-3, &Vector1::new(y), &u)
+                .unwrap();
+            assert_eq!(observer.report().impacts, 0, "step {k}");
+            sum_sq += estimate.v[0] * estimate.v[0];
+        }
+        let rms = (sum_sq / 4000.0).sqrt();
+        // about l_d σ (measured 1.8 l_d σ: the estimate is kept in V(q), so
+        // the approaching half of the noise is cut and the rest
+        // accumulates); bounded by three times that
+        assert!(rms < 3.0 * 10.0 * sigma, "{rms}");
+    }
+
+    /// A puck of unit mass on the floor `y ≥ 0`, pressed by gravity and
+    /// pushed along by a constant force `f`.
+    struct Puck {
+        f: f64,
+    }
+
+    impl Model<2, 1> for Puck {
+        type Scalar = f64;
+        type Input = SVector<f64, 0>;
+        const INFO: ModelInfo<2, 1> = ModelInfo {
+            name: "Puck",
+            coordinates: ["x", "y"],
+            velocities: ["vx", "vy"],
+            constraints: ["floor"],
+            parameters: &[],
+            inputs: &[],
+            source: "",
+            op_count: 0,
+        };
+        fn mass(&self, _: &Vector2<f64>) -> Matrix2<f64> {
+            Matrix2::identity()
+        }
+        fn coriolis(&self, _: &Vector2<f64>, _: &Vector2<f64>) -> Matrix2<f64> {
+            Matrix2::zeros()
+        }
+        fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> {
+            Vector2::new(0.0, 9.81)
+        }
+        fn forces(
+            &self,
+            _: f64,
+            q: &Vector2<f64>,
+            _: &Vector2<f64>,
+            _: &SVector<f64, 0>,
+        ) -> Vector2<f64> {
+            self.gravity(q) - Vector2::new(self.f, 0.0)
+        }
+        fn gaps(&self, q: &Vector2<f64>) -> Vector1<f64> {
+            Vector1::new(q[1])
+        }
+        fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 1, 2> {
+            SMatrix::<f64, 1, 2>::new(0.0, 1.0)
+        }
+        fn restitution(&self) -> Vector1<f64> {
+            Vector1::new(0.9)
+        }
+        fn parameter(&self, _: usize) -> Option<f64> {
+            None
+        }
+        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
+            None
+        }
+    }
+
+    /// Sliding: the contact force cancels the normal part of gravity, the
+    /// estimate stays tangent, and the tangential error decays exactly like
+    /// `e^{−l_d t}` (the contact does not disturb the injection).
+    #[test]
+    fn sliding_keeps_the_estimate_tangent() {
+        let puck = Puck { f: 2.0 };
+        let u = SVector::zeros();
+        let params = ObserverParams::new(10.0, 20.0);
+        let mut observer =
+            ReducedOrder::<f64, 2, 1>::new(params, 0.0, Vector2::zeros(), Vector2::new(1.0, 0.0))
+                .unwrap();
+        for k in 1..=300 {
+            let t = k as f64 * 1e-3;
+            let q = Vector2::new(0.5 * puck.f * t * t, 0.0);
+            let estimate = observer.update(&puck, t, &q, &u).unwrap();
+            assert_eq!(estimate.v[1], 0.0);
+            assert_eq!(observer.report().impacts, 0);
+            assert!(observer.report().contacts.contains(0));
+            let error = estimate.v[0] - puck.f * t;
+            assert!((error - (-10.0 * t).exp()).abs() < 1e-12, "{error}");
+        }
+    }
+
+    /// The observer is generic in the scalar: `f32` runs the same bounce.
+    #[test]
+    fn runs_in_f32() {
+        struct Ball32;
+        impl Model<1, 1> for Ball32 {
+            type Scalar = f32;
+            type Input = SVector<f32, 0>;
+            const INFO: ModelInfo<1, 1> = Ball::INFO;
+            fn mass(&self, _: &Vector1<f32>) -> Matrix1<f32> {
+                Matrix1::new(1.0)
+            }
+            fn coriolis(&self, _: &Vector1<f32>, _: &Vector1<f32>) -> Matrix1<f32> {
+                Matrix1::zeros()
+            }
+            fn gravity(&self, _: &Vector1<f32>) -> Vector1<f32> {
+                Vector1::new(9.81)
+            }
+            fn forces(
+                &self,
+                _: f32,
+                q: &Vector1<f32>,
+                _: &Vector1<f32>,
+                _: &SVector<f32, 0>,
+            ) -> Vector1<f32> {
+                self.gravity(q)
+            }
+            fn gaps(&self, q: &Vector1<f32>) -> Vector1<f32> {
+                *q
+            }
+            fn gap_jacobian(&self, _: &Vector1<f32>) -> Matrix1<f32> {
+                Matrix1::new(1.0)
+            }
+            fn restitution(&self) -> Vector1<f32> {
+                Vector1::new(0.8)
+            }
+            fn parameter(&self, _: usize) -> Option<f32> {
+                None
+            }
+            fn parameter_mut(&mut self, _: usize) -> Option<&mut f32> {
+                None
+            }
+        }
+        let params = ObserverParams::new(10.0_f32, 20.0);
+        let mut observer =
+            ReducedOrder::<f32, 1, 1>::new(params, 0.0, Vector1::new(1.0), Vector1::zeros())
+                .unwrap();
+        let mut worst = 0.0_f32;
+        for k in 1..=1000 {
+            let t = k as f64 * 1e-3;
+            let (y, v, _) = exact_ball(9.81, 0.8, 1.0, t);
+            let estimate = observer
+                .update(
+                    &Ball32,
+                    t as f32,
+                    &Vector1::new(y as f32),
+                    &SVector::zeros(),
+                )
+                .unwrap();
+            worst = worst.max((estimate.v[0] - v as f32).abs());
+        }
+        // single precision: positions to 6e-8 m over τ = 1 ms are velocities
+        // to ~1e-4 m/s, times the gain's filtering
+        assert!(worst < 1e-2, "{worst}");
+    }
+}

@@ -1,0 +1,81 @@
+//! What an observer update tells its caller.
+
+use nalgebra::{RealField, SVector};
+
+use crate::lcp::IndexSet;
+
+/// What happened in one update: `no_std` has no clock, so the stages are
+/// counted, as the plant's [`StepReport`](crate::StepReport) does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
+    /// Time of the measurement, `t_{k+1}`.
+    pub t: T,
+    /// The sampling interval `τ = t_{k+1} − t_k`.
+    pub tau: T,
+    /// Impacts located inside the interval. With
+    /// [`ImpactAware`](super::Discretization::ImpactAware): each Newton's
+    /// law that gave an impulse to a constraint approaching faster than its
+    /// resting speed (at a root of a gap along the predicted motion, at a
+    /// closed constraint met approaching, or at the end of the interval);
+    /// the plastic closure of a slower approach counts as a contact. With
+    /// [`SectionVii`](super::Discretization::SectionVii): `1` when its LCP
+    /// gave an impulse.
+    pub impacts: u32,
+    /// Time of the first impact in the interval, if any.
+    pub first_impact: Option<T>,
+    /// Constraints that received an impulse at an impact.
+    pub impacted: IndexSet,
+    /// Constraints treated as persistent contacts during the interval (the
+    /// mass sliding along them).
+    pub contacts: IndexSet,
+    /// Every constraint that took part in a complementarity problem.
+    pub active: IndexSet,
+    /// Sum over the interval of the multipliers per constraint: impulses `λ`
+    /// of the impacts plus the integral `∫ λ dt` of the contact forces
+    /// (momentum units, as `Jᵀλ`).
+    pub impulses: SVector<T, K>,
+    /// Complementarity problems solved.
+    pub lcp_solves: u32,
+    /// Complementary sets they tried, in total.
+    pub lcp_trials: u32,
+    /// The largest scaled complementarity residual among them.
+    pub lcp_residual: T,
+    /// The innovation `q_{k+1} − q_pred`: the measured end position minus
+    /// the position predicted from `q_k` and the estimate (for
+    /// `SectionVii`, `q_{k+1} − q_k − τ v̂_k`).
+    pub innovation: SVector<T, N>,
+    /// Evaluations of the model's dynamics `(M, F)`.
+    pub evaluations: u32,
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> UpdateReport<T, N, K> {
+    /// An empty report for the interval ending at `t`, of length `tau`.
+    pub(crate) fn new(t: T, tau: T) -> Self {
+        Self {
+            t,
+            tau,
+            impacts: 0,
+            first_impact: None,
+            impacted: IndexSet::EMPTY,
+            contacts: IndexSet::EMPTY,
+            active: IndexSet::EMPTY,
+            impulses: SVector::zeros(),
+            lcp_solves: 0,
+            lcp_trials: 0,
+            lcp_residual: T::zero(),
+            innovation: SVector::zeros(),
+            evaluations: 0,
+        }
+    }
+
+    /// The velocity correction the last update's innovation made,
+    /// `|d| (1 − e^{−l_d τ}) / τ` (0 before the first update): how much the
+    /// estimate still moves, so how well it knows the velocity.
+    pub(crate) fn uncertainty(&self, l_d: T) -> T {
+        if self.tau > T::zero() {
+            self.innovation.norm() * super::interval::injection_gain(l_d, self.tau)
+        } else {
+            T::zero()
+        }
+    }
+}
