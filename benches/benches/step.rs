@@ -1,10 +1,14 @@
-//! One time step of the plant stepper on each shipped model, in free flight
-//! and with active constraints (impacts, persistent contact).
+//! One time step of the plant stepper, and one update of each observer, on
+//! each shipped model, in free flight and with active constraints (impacts,
+//! persistent contact).
 //!
 //! `cargo bench -p moreau-bench --bench step`
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use moreau::{Model, MoreauJean, State, StepParams};
+use moreau::{
+    Discretization, FullOrder, FullOrderGains, Model, MoreauJean, Observer, ObserverParams,
+    ReducedOrder, State, StepParams,
+};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
 use std::hint::black_box;
@@ -63,6 +67,44 @@ fn bench_model<M, const N: usize, const K: usize, const NU: usize>(
                 s
             })
         });
+    }
+    group.finish();
+
+    // observers: one update from a converged estimate, 1 ms after the state
+    let mut group = c.benchmark_group(format!("observer/{name}"));
+    let mut cases = vec![("free flight", free)];
+    if let Some((contact, active)) = busiest {
+        cases.push((if active > 1 { "contacts" } else { "contact" }, contact));
+    }
+    for (label, start) in cases {
+        let mut next = start;
+        for _ in 0..1 {
+            stepper.step(&model, &mut next, &u).unwrap();
+        }
+        for scheme in [Discretization::ImpactAware, Discretization::SectionVii] {
+            let params = ObserverParams::new(10.0, 50.0).with_scheme(scheme);
+            let tag = match scheme {
+                Discretization::ImpactAware => "impact-aware",
+                Discretization::SectionVii => "section-vii",
+            };
+            let reduced =
+                ReducedOrder::<f64, N, K>::new(params, start.t, start.q, start.v).unwrap();
+            group.bench_function(format!("reduced {tag}, {label}"), |b| {
+                b.iter(|| {
+                    let mut o = black_box(reduced);
+                    o.update(&model, next.t, &next.q, &u).unwrap()
+                })
+            });
+            let gains = FullOrderGains::scalar(10.0, 10.0);
+            let full =
+                FullOrder::<f64, N, K>::new(params, gains, start.t, start.q, start.v).unwrap();
+            group.bench_function(format!("full {tag}, {label}"), |b| {
+                b.iter(|| {
+                    let mut o = black_box(full);
+                    o.update(&model, next.t, &next.q, &u).unwrap()
+                })
+            });
+        }
     }
     group.finish();
 }

@@ -6,7 +6,7 @@ use crate::lcp::Lcp;
 use crate::linalg::SymmetricEigen;
 use crate::model::Model;
 
-use super::interval::{Interval, factor_mass, finite, saturate};
+use super::interval::{Interval, factor_mass, finite, injection_gain, saturate};
 use super::reduced_order::section_vii_impact;
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
@@ -371,9 +371,11 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for 
             q0: self.q,
             q1: *q,
             restitution,
-            uncertainty: self.report.uncertainty(self.params.l_d),
+            uncertainty: self.report.uncertainty(),
+            gain: injection_gain(self.params.l_d, tau),
         };
         let mut report = UpdateReport::new(t, tau);
+        report.gain = interval.gain;
         let (q_hat, v) = match self.params.scheme {
             Discretization::ImpactAware => self.impact_aware(&interval, &mut report)?,
             Discretization::SectionVii => self.section_vii(&interval, &mut report)?,

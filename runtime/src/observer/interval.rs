@@ -147,6 +147,9 @@ where
     pub q1: SVector<T, N>,
     /// The observer's restitution `ê`.
     pub restitution: SVector<T, K>,
+    /// The injection gain `(1 − e^{−l_d τ}) / τ` of this interval
+    /// ([`injection_gain`], computed once per update).
+    pub gain: T,
     /// How well the estimate knows the velocity: the correction the last
     /// update's innovation made, `|d_k| (1 − e^{−l_d τ_k}) / τ_k` (0 before
     /// the first update). A closed constraint approaching slower than that
@@ -342,7 +345,7 @@ where
         p.noise_sigmas
             * p.noise
             * nalgebra::convert::<f64, T>(core::f64::consts::SQRT_2)
-            * injection_gain(p.l_d, self.tau)
+            * self.gain
     }
 
     /// Sorts the constraints at a point `(p, w)` of the predicted motion

@@ -225,9 +225,11 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
             q0: self.q,
             q1: *q,
             restitution,
-            uncertainty: self.report.uncertainty(self.params.l_d),
+            uncertainty: self.report.uncertainty(),
+            gain: injection_gain(self.params.l_d, tau),
         };
         let mut report = UpdateReport::new(t, tau);
+        report.gain = interval.gain;
         let v = match self.params.scheme {
             Discretization::ImpactAware => {
                 // PREDICT from (q_k, v̂_k), impacts inside the interval
@@ -236,7 +238,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
                 // displacement, integrated exactly over τ
                 let innovation = q - p_end;
                 report.innovation = innovation;
-                let v = w_end + innovation * injection_gain(self.params.l_d, tau);
+                let v = w_end + innovation * interval.gain;
                 // CLOSE: v̂_e ∈ V(q_{k+1})
                 interval.close_at_end(&v, &mut report)?
             }

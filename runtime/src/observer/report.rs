@@ -44,6 +44,9 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     /// the position predicted from `q_k` and the estimate (for
     /// `SectionVii`, `q_{k+1} − q_k − τ v̂_k`).
     pub innovation: SVector<T, N>,
+    /// The injection gain `(1 − e^{−l_d τ}) / τ` the update used (the
+    /// velocity correction is this times the innovation).
+    pub gain: T,
     /// Evaluations of the model's dynamics `(M, F)`.
     pub evaluations: u32,
 }
@@ -64,6 +67,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> UpdateReport<T, N, K> 
             lcp_trials: 0,
             lcp_residual: T::zero(),
             innovation: SVector::zeros(),
+            gain: T::zero(),
             evaluations: 0,
         }
     }
@@ -71,11 +75,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> UpdateReport<T, N, K> 
     /// The velocity correction the last update's innovation made,
     /// `|d| (1 − e^{−l_d τ}) / τ` (0 before the first update): how much the
     /// estimate still moves, so how well it knows the velocity.
-    pub(crate) fn uncertainty(&self, l_d: T) -> T {
-        if self.tau > T::zero() {
-            self.innovation.norm() * super::interval::injection_gain(l_d, self.tau)
-        } else {
-            T::zero()
-        }
+    pub(crate) fn uncertainty(&self) -> T {
+        self.innovation.norm() * self.gain
     }
 }
