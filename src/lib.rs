@@ -37,6 +37,38 @@
 //! assert_eq!(terms.jacobian.row(0)[0], -2.0); // ∂h1/∂x = -2x
 //! assert_eq!(terms.forces, Vector2::new(0.0, 9.81));
 //! ```
+//!
+//! An observer estimates the velocity from measured positions alone, through
+//! the impacts (the paper's reduced-order observer (38), with a gain chosen
+//! for a guaranteed decay rate by Corollary 3):
+//!
+//! ```
+//! use moreau::{Design, GainRegion, ModelBounds, Observer, ObserverParams, ReducedOrder};
+//! use moreau_models::Parabola;
+//! use nalgebra::{SVector, Vector2};
+//! # use moreau::{MoreauJean, State, StepParams};
+//! # let plant = MoreauJean::new(StepParams::new(1e-5))?;
+//! # let (q0, v0) = Parabola::<f64>::initial_state();
+//! # let mut state = State::new(0.0, q0, v0);
+//! # let samples: Vec<(f64, Vector2<f64>)> = (1..=2000).map(|k| {
+//! #     for _ in 0..100 { plant.step(&Parabola::<f64>::default(), &mut state, &SVector::zeros()).unwrap(); }
+//! #     (k as f64 * 1e-3, state.q)
+//! # }).collect();
+//!
+//! let model = Parabola::<f64>::default();
+//! let region = GainRegion::new(Vector2::new(-3.0, 0.0), Vector2::new(3.0, 8.0), 20.0);
+//! let bounds = ModelBounds::estimate(&model, &region, &SVector::zeros())?;
+//! let l_d = bounds.gain(Design::ReducedOrder, 10.0); // decay rate β = 10
+//! let params = ObserverParams::new(l_d, 20.0); // gain l_d, velocity bound C_v
+//! let mut observer = ReducedOrder::new(params, 0.0, q0, Vector2::zeros())?;
+//! for (t, q) in &samples {
+//!     let estimate = observer.update(&model, *t, q, &SVector::zeros())?;
+//!     // estimate.v: the velocity, after every impact of the interval
+//! #   let _ = estimate;
+//! }
+//! # assert!((observer.estimate().v - state.v).norm() < 1e-3);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 

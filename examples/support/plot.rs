@@ -19,8 +19,8 @@ pub struct Series {
     pub label: String,
     pub color: RGBColor,
     pub points: Vec<(f64, f64)>,
-    /// Drawn dashed (estimates), else solid (true values).
-    pub dashed: bool,
+    /// Drawn thin over the others (estimates), else thick (true values).
+    pub thin: bool,
     /// Drawn as dots (sparse events), else as a line.
     pub dots: bool,
 }
@@ -28,17 +28,29 @@ pub struct Series {
 impl Series {
     /// A solid line.
     pub fn line(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
-        Self { label: label.into(), color, points, dashed: false, dots: false }
+        Self {
+            label: label.into(),
+            color,
+            points,
+            thin: false,
+            dots: false,
+        }
     }
 
-    /// A dashed line.
-    pub fn dashed(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
-        Self { dashed: true, ..Self::line(label, color, points) }
+    /// A thin line, drawn over the thick ones: an estimate over the truth.
+    pub fn thin(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            thin: true,
+            ..Self::line(label, color, points)
+        }
     }
 
     /// Dots.
     pub fn dots(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
-        Self { dots: true, ..Self::line(label, color, points) }
+        Self {
+            dots: true,
+            ..Self::line(label, color, points)
+        }
     }
 }
 
@@ -55,25 +67,36 @@ pub struct Panel {
 impl Panel {
     /// A panel with a linear y axis and no inset.
     pub fn new(y_label: &str, series: Vec<Series>) -> Self {
-        Self { y_label: y_label.into(), series, inset: None, log_y: false }
+        Self {
+            y_label: y_label.into(),
+            series,
+            inset: None,
+            log_y: false,
+        }
     }
 
     /// The same panel with a magnified inset over `x ∈ [a, b]`.
     pub fn with_inset(self, a: f64, b: f64) -> Self {
-        Self { inset: Some((a, b)), ..self }
+        Self {
+            inset: Some((a, b)),
+            ..self
+        }
     }
 
     /// The same panel with a logarithmic y axis.
     pub fn log(self) -> Self {
-        Self { log_y: true, ..self }
+        Self {
+            log_y: true,
+            ..self
+        }
     }
 }
 
 /// Where the examples write: `out/` at the workspace root, or `$MOREAU_OUT`.
 pub fn out_dir() -> Result<PathBuf> {
-    let dir = std::env::var_os("MOREAU_OUT").map(PathBuf::from).unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("out")
-    });
+    let dir = std::env::var_os("MOREAU_OUT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("out"));
     std::fs::create_dir_all(&dir)?;
     Ok(dir)
 }
@@ -98,22 +121,26 @@ pub fn figure(stem: &str, title: &str, x_label: &str, panels: &[Panel]) -> Resul
     let svg = dir.join(format!("{stem}.svg"));
     {
         let root = BitMapBackend::new(&png, size).into_drawing_area();
-        draw(&root, title, x_label, panels)?;
+        draw(&root, title, x_label, panels, true)?;
         root.present()?;
     }
     {
         let root = SVGBackend::new(&svg, size).into_drawing_area();
-        draw(&root, title, x_label, panels)?;
+        draw(&root, title, x_label, panels, false)?;
         root.present()?;
     }
     Ok([png, svg])
 }
 
+/// `segments`: draw lines segment by segment (bitmaps: plotters' thick
+/// polylines draw unbounded miter spikes where a line turns back on
+/// itself; SVG viewers cap them, so SVG keeps polylines).
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
     x_label: &str,
     panels: &[Panel],
+    segments: bool,
 ) -> Result<()>
 where
     DB::ErrorType: 'static,
@@ -123,7 +150,7 @@ where
     let areas = root.split_evenly((panels.len(), 1));
     let x_range = x_extent(panels);
     for (area, panel) in areas.iter().zip(panels) {
-        chart(area, panel, x_range, x_label, false)?;
+        chart(area, panel, x_range, x_label, false, segments)?;
         if let Some((a, b)) = panel.inset {
             let (w, h) = area.dim_in_pixel();
             let inset = area.clone().shrink(
@@ -131,16 +158,30 @@ where
                 ((w as f64 * 0.40) as u32, (h as f64 * 0.50) as u32),
             );
             inset.fill(&WHITE)?;
-            inset.draw(&Rectangle::new([(0, 0), (inset.dim_in_pixel().0 as i32 - 1, inset.dim_in_pixel().1 as i32 - 1)], BLACK.mix(0.4)))?;
-            chart(&inset, panel, (a, b), "", true)?;
+            inset.draw(&Rectangle::new(
+                [
+                    (0, 0),
+                    (
+                        inset.dim_in_pixel().0 as i32 - 1,
+                        inset.dim_in_pixel().1 as i32 - 1,
+                    ),
+                ],
+                BLACK.mix(0.4),
+            ))?;
+            chart(&inset, panel, (a, b), "", true, segments)?;
         }
     }
     Ok(())
 }
 
 fn x_extent(panels: &[Panel]) -> (f64, f64) {
-    let xs = panels.iter().flat_map(|p| p.series.iter()).flat_map(|s| s.points.iter().map(|p| p.0));
-    let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    let xs = panels
+        .iter()
+        .flat_map(|p| p.series.iter())
+        .flat_map(|s| s.points.iter().map(|p| p.0));
+    let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
     if lo < hi { (lo, hi) } else { (0.0, 1.0) }
 }
 
@@ -152,9 +193,15 @@ fn y_extent(panel: &Panel, x: (f64, f64)) -> (f64, f64) {
         .filter(|p| p.0 >= x.0 && p.0 <= x.1 && p.1.is_finite())
         .filter(|p| !panel.log_y || p.1 > 0.0)
         .map(|p| p.1);
-    let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
-    if !(lo < hi) {
-        return if lo.is_finite() { (lo - 1.0, lo + 1.0) } else { (0.0, 1.0) };
+    let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    if lo >= hi {
+        return if lo.is_finite() {
+            (lo - 1.0, lo + 1.0)
+        } else {
+            (0.0, 1.0)
+        };
     }
     if panel.log_y {
         (lo.max(1e-12), hi * 2.0)
@@ -170,6 +217,7 @@ fn chart<DB: DrawingBackend>(
     x: (f64, f64),
     x_label: &str,
     inset: bool,
+    segments: bool,
 ) -> Result<()>
 where
     DB::ErrorType: 'static,
@@ -180,26 +228,49 @@ where
     builder
         .margin(if inset { 4 } else { 10 })
         .x_label_area_size(if inset { 20 } else { 36 })
-        .y_label_area_size(if inset { 44 } else { 70 });
-    let visible: Vec<&Series> = panel.series.iter().filter(|s| !s.points.is_empty()).collect();
+        .y_label_area_size(if inset { 44 } else { 80 });
+    let visible: Vec<&Series> = panel
+        .series
+        .iter()
+        .filter(|s| !s.points.is_empty())
+        .collect();
     macro_rules! body {
         ($chart:expr) => {{
             let mut chart = $chart;
             let mut mesh = chart.configure_mesh();
-            mesh.label_style(("sans-serif", font)).light_line_style(WHITE.mix(0.0));
+            mesh.label_style(("sans-serif", font))
+                .light_line_style(WHITE.mix(0.0));
+            if panel.log_y {
+                mesh.y_label_formatter(&|y: &f64| format!("{y:.0e}"));
+            }
             if !inset {
                 mesh.x_desc(x_label).y_desc(panel.y_label.as_str());
             }
             mesh.draw()?;
             for s in &visible {
-                let pts = s.points.iter().copied().filter(|p| p.0 >= x.0 && p.0 <= x.1);
+                // plotters does not clip lines to the chart: clamp into it
+                // (and keep non-positive values on a log axis at its floor)
+                let pts: Vec<(f64, f64)> = s
+                    .points
+                    .iter()
+                    .filter(|p| p.0 >= x.0 && p.0 <= x.1 && !p.1.is_nan())
+                    .map(|p| (p.0, p.1.clamp(y.0, y.1)))
+                    .collect();
+                let pts = decimate(&pts, x, area.dim_in_pixel().0 as usize);
                 let color = s.color;
+                let style = color.stroke_width(if s.thin { 1 } else { 3 });
                 let drawn = if s.dots {
-                    chart.draw_series(pts.map(move |p| Circle::new(p, 2, color.filled())))?
-                } else if s.dashed {
-                    chart.draw_series(DashedLineSeries::new(pts, 6, 4, color.stroke_width(2)))?
+                    chart.draw_series(
+                        pts.into_iter()
+                            .map(move |p| Circle::new(p, 2, color.filled())),
+                    )?
+                } else if segments {
+                    chart.draw_series(
+                        pts.windows(2)
+                            .map(move |w| PathElement::new(vec![w[0], w[1]], style)),
+                    )?
                 } else {
-                    chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))?
+                    chart.draw_series(LineSeries::new(pts, style))?
                 };
                 if !inset {
                     drawn.label(s.label.as_str()).legend(move |(px, py)| {
@@ -226,8 +297,43 @@ where
     Ok(())
 }
 
+/// Keeps, of every one of `columns` slices of `x`, the first, lowest,
+/// highest and last point, in time order: the drawn envelope is unchanged
+/// and a figure of any length stays small.
+fn decimate(points: &[(f64, f64)], x: (f64, f64), columns: usize) -> Vec<(f64, f64)> {
+    let width = (x.1 - x.0) / columns.max(1) as f64;
+    let column = |p: &(f64, f64)| ((p.0 - x.0) / width) as i64;
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < points.len() {
+        let c = column(&points[start]);
+        let end = start
+            + points[start..]
+                .iter()
+                .take_while(|p| column(p) == c)
+                .count();
+        let slice = &points[start..end];
+        let lowest = (0..slice.len())
+            .min_by(|&a, &b| slice[a].1.total_cmp(&slice[b].1))
+            .unwrap_or(0);
+        let highest = (0..slice.len())
+            .max_by(|&a, &b| slice[a].1.total_cmp(&slice[b].1))
+            .unwrap_or(0);
+        let mut keep = vec![0, lowest, highest, slice.len() - 1];
+        keep.sort_unstable();
+        keep.dedup();
+        out.extend(keep.into_iter().map(|i| slice[i]));
+        start = end;
+    }
+    out
+}
+
 /// Writes `out/<stem>.csv` with a header line and one row per record.
-pub fn csv(stem: &str, header: &[&str], rows: impl IntoIterator<Item = Vec<f64>>) -> Result<PathBuf> {
+pub fn csv(
+    stem: &str,
+    header: &[&str],
+    rows: impl IntoIterator<Item = Vec<f64>>,
+) -> Result<PathBuf> {
     let path = out_dir()?.join(format!("{stem}.csv"));
     let mut file = std::io::BufWriter::new(std::fs::File::create(&path)?);
     writeln!(file, "{}", header.join(","))?;
