@@ -13,6 +13,10 @@ use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
 use std::hint::black_box;
 
+/// A free-flight state, and the state with the most active constraints
+/// with their number.
+type Cases<const N: usize> = (Option<State<f64, N>>, Option<(State<f64, N>, usize)>);
+
 /// Runs the model from its initial state and keeps the first state whose
 /// step has no active constraint (free flight; the three balls have none:
 /// balls 2 and 3 stay in contact) and the state whose step has the most
@@ -21,7 +25,7 @@ fn states<M, const N: usize, const K: usize, const NU: usize>(
     model: &M,
     q0: SVector<f64, N>,
     v0: SVector<f64, N>,
-) -> (Option<State<f64, N>>, Option<(State<f64, N>, usize)>)
+) -> Cases<N>
 where
     M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
 {

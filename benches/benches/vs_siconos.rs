@@ -46,8 +46,14 @@ fn main() {
     let (q, v) = DoublePendulum::<f64>::initial_state();
     let pendulum = moreau_per_step::<_, 2, 2>(&DoublePendulum::<f64>::default(), q, v, 5_000);
     println!("moreau (Rust, generated model), whole run, best of 5:");
-    println!("  parabola         10000 steps  {:8.3} us/step", parabola * 1e6);
-    println!("  double_pendulum   5000 steps  {:8.3} us/step", pendulum * 1e6);
+    println!(
+        "  parabola         10000 steps  {:8.3} us/step",
+        parabola * 1e6
+    );
+    println!(
+        "  double_pendulum   5000 steps  {:8.3} us/step",
+        pendulum * 1e6
+    );
     let siconos = Command::new("/usr/bin/python3")
         .arg(format!("{root}/tests/siconos_reference.py"))
         .arg("--time")
