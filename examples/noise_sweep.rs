@@ -15,7 +15,7 @@ use moreau_models::Parabola;
 use nalgebra::Vector2;
 use plotters::style::full_palette::{BLUE_700, GREEN_700, ORANGE_800, RED_600};
 use support::observe::{quantile, run, window};
-use support::plot::{Panel, Result, Series, csv, figure};
+use support::plot::{Panel, Result, Series, announce, csv, figure};
 use support::reference::{Sampling, sample};
 
 const T_END: f64 = 10.0;
@@ -83,12 +83,6 @@ fn main() -> Result<()> {
     );
     let header: Vec<&str> = header.iter().map(String::as_str).collect();
     let data = csv("noise_sweep", &header, rows)?;
-    println!();
-    println!(
-        "wrote {}, {}, {}",
-        png.display(),
-        svg.display(),
-        data.display()
-    );
+    announce(&[&png, &svg, &data]);
     Ok(())
 }

@@ -14,7 +14,7 @@ use moreau::{Model, ObserverParams, ReducedOrder};
 use moreau_models::Parabola;
 use plotters::style::full_palette::{BLUE_700, GREY_400, ORANGE_800, RED_600};
 use support::observe::{at, quantile, run, window};
-use support::plot::{Panel, Result, Series, csv, figure};
+use support::plot::{Panel, Result, Series, announce, csv, figure};
 use support::reference::{Sampling, episodes, sample};
 
 /// The plant's step and the sampling period of the measurements.
@@ -142,12 +142,6 @@ fn main() -> Result<()> {
             ]
         }),
     )?;
-    println!();
-    println!(
-        "wrote {}, {}, {}",
-        png.display(),
-        svg.display(),
-        data.display()
-    );
+    announce(&[&png, &svg, &data]);
     Ok(())
 }

@@ -13,7 +13,7 @@ use moreau_models::Billiard;
 use nalgebra::{Vector2, Vector4};
 use plotters::style::full_palette::{BLUE_700, RED_600};
 use support::observe::{quantile, run, window};
-use support::plot::{Panel, Result, Series, csv, figure};
+use support::plot::{Panel, Result, Series, announce, csv, figure};
 use support::reference::{Sampling, episodes, sample};
 
 const T_END: f64 = 20.0;
@@ -111,12 +111,6 @@ fn main() -> Result<()> {
         ],
         rows.iter().map(|r| r.to_vec()),
     )?;
-    println!();
-    println!(
-        "wrote {}, {}, {}",
-        png.display(),
-        svg.display(),
-        data.display()
-    );
+    announce(&[&png, &svg, &data]);
     Ok(())
 }

@@ -10,7 +10,7 @@ use plotters::style::full_palette::{
 };
 
 use super::observe::{at, quantile, run, window};
-use super::plot::{Panel, Result, Series, csv, figure};
+use super::plot::{Panel, Result, Series, announce, csv, figure};
 use super::reference::{Sampling, episodes, sample};
 
 /// One comparison.
@@ -158,12 +158,6 @@ where
             row
         }),
     )?;
-    println!();
-    println!(
-        "wrote {}, {}, {}",
-        png.display(),
-        svg.display(),
-        data.display()
-    );
+    announce(&[&png, &svg, &data]);
     Ok(())
 }

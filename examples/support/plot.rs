@@ -344,3 +344,10 @@ pub fn csv(
     file.flush()?;
     Ok(path)
 }
+
+/// Prints, after a blank line, the files an example wrote.
+pub fn announce(paths: &[&std::path::Path]) {
+    let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    println!();
+    println!("wrote {}", list.join(", "));
+}

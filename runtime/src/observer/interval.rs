@@ -11,7 +11,7 @@ use crate::lcp::{IndexSet, Lcp};
 use crate::linalg::Cholesky;
 use crate::model::Model;
 
-use super::{ObserverError, ObserverParams, UpdateReport};
+use super::{ObserverError, ObserverParams, UpdateReport, check_restitution, check_update};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
@@ -155,6 +155,57 @@ where
     /// the first update). A closed constraint approaching slower than that
     /// cannot be told from a resting one.
     pub uncertainty: T,
+}
+
+/// What an observer remembers between updates, as the interval needs it.
+pub(crate) struct Memory<'a, T: RealField + Copy, const N: usize, const K: usize> {
+    pub params: &'a ObserverParams<T>,
+    pub lcp: &'a Lcp<T>,
+    /// `t_k` and the measured `q_k`.
+    pub t: T,
+    pub q: SVector<T, N>,
+    /// The observer's own `ê`, if it has one.
+    pub restitution: Option<SVector<T, K>>,
+    /// The last update's report.
+    pub report: &'a UpdateReport<T, N, K>,
+}
+
+impl<'a, M, T, const N: usize, const K: usize> Interval<'a, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    /// Checks one update's data (the measurement `q` at `t`, the input
+    /// `u`, the model's parameters and restitution) and opens the interval
+    /// `[t_k, t]` with an empty report.
+    pub fn begin(
+        model: &'a M,
+        u: &'a M::Input,
+        memory: Memory<'a, T, N, K>,
+        t: T,
+        q: &SVector<T, N>,
+    ) -> Result<(Self, UpdateReport<T, N, K>), T> {
+        let tau = check_update(model, memory.t, t, q, u)?;
+        let restitution = memory.restitution.unwrap_or_else(|| model.restitution());
+        check_restitution(&restitution)?;
+        let gain = injection_gain(memory.params.l_d, tau);
+        let interval = Interval {
+            model,
+            u,
+            params: memory.params,
+            lcp: memory.lcp,
+            t0: memory.t,
+            tau,
+            q0: memory.q,
+            q1: *q,
+            restitution,
+            uncertainty: memory.report.uncertainty(),
+            gain,
+        };
+        let mut report = UpdateReport::new(t, tau);
+        report.gain = gain;
+        Ok((interval, report))
+    }
 }
 
 impl<M, T, const N: usize, const K: usize> Interval<'_, M, T, N, K>

@@ -6,10 +6,10 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Interval, factor_mass, finite, injection_gain, saturate};
+use super::interval::{Interval, Memory, factor_mass, finite, saturate};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
-    check_restitution, check_update, check_vector,
+    check_restitution, check_vector,
 };
 
 /// The reduced-order velocity observer (38): `q̂ = q`, and
@@ -212,24 +212,15 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
     where
         M: Model<N, K, Scalar = T>,
     {
-        let tau = check_update(model, self.t, t, q, u)?;
-        let restitution = self.restitution.unwrap_or_else(|| model.restitution());
-        check_restitution(&restitution)?;
-        let interval = Interval {
-            model,
-            u,
+        let memory = Memory {
             params: &self.params,
             lcp: &self.lcp,
-            t0: self.t,
-            tau,
-            q0: self.q,
-            q1: *q,
-            restitution,
-            uncertainty: self.report.uncertainty(),
-            gain: injection_gain(self.params.l_d, tau),
+            t: self.t,
+            q: self.q,
+            restitution: self.restitution,
+            report: &self.report,
         };
-        let mut report = UpdateReport::new(t, tau);
-        report.gain = interval.gain;
+        let (interval, mut report) = Interval::begin(model, u, memory, t, q)?;
         let v = match self.params.scheme {
             Discretization::ImpactAware => {
                 // PREDICT from (q_k, v̂_k), impacts inside the interval
