@@ -160,84 +160,130 @@ impl<T: RealField + Copy> MoreauJean<T> {
         M: Model<N, K, Scalar = T>,
     {
         check_inputs(model, state, u)?;
-        let p = &self.params;
-        let (tau, theta) = (p.tau, p.theta);
-        let State {
-            t: t_k,
-            q: q_k,
-            v: v_k,
-        } = *state;
-        let t_next = t_k + tau;
-
-        // INDEX SET: γ-prediction at the start of the step.
-        let (gaps, jac_k) = model.contact(&q_k);
-        finite_matrix(&gaps, "h")?;
-        finite_matrix(&jac_k, "J")?;
-        let jv_k = jac_k * v_k;
-        let active = predict_index_set(&gaps, &jv_k, p.gamma * tau);
-        let restitution = model.restitution();
-        let forces_k = model.forces(t_k, &q_k, &v_k, u);
-        finite_matrix(&forces_k, "F")?;
-
-        // NEWTON: from the first iterate (q_k + τ v_k, v_k).
-        let mut iterate = (q_k + v_k * tau, v_k);
-        let mut report = StepReport {
-            t: t_next,
-            active,
-            impulses: SVector::zeros(),
-            lcp_trials: 0,
-            lcp_residual: T::zero(),
-            newton_iterations: 0,
-            newton_residual: T::zero(),
-            converged: false,
-        };
+        // INDEX SET by γ-prediction, and what the step keeps from its start
+        let start = self.begin(model, state, u)?;
+        let mut report = StepReport::new(start.t_next, start.active);
+        // NEWTON, from the first iterate (q_k + τ v_k, v_k)
+        let mut iterate = (start.q + start.v * self.params.tau, start.v);
         loop {
-            let (q_i, v_i) = iterate;
-            let lin = model.linearization(t_next, &q_i, &v_i, u);
-            check_mass(&lin.mass)?;
-            finite_matrix(&lin.forces, "F")?;
-            let w = iteration_matrix(&lin.mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
-            let residual = lin.mass * (v_i - v_k)
-                + forces_k * (tau * (T::one() - theta))
-                + lin.forces * (tau * theta);
-            let v_free = v_i - solve(&w, &residual)?;
-            let jac = model.gap_jacobian(&q_i);
-            finite_matrix(&jac, "J")?;
-            // Newton's law compares J v_{k+1} with e u.
-            let approach = match p.approach_velocity {
-                ApproachVelocity::Start => jv_k,
-                ApproachVelocity::Iterate => jac * v_k,
-                ApproachVelocity::Slower => jv_k.sup(&(jac * v_k)),
-            };
-            let restitution_term = restitution.component_mul(&approach);
-            let impulse = self.solve_impulses(&w, &jac, &v_free, &restitution_term, active)?;
-            let v_next = v_free + impulse.velocity_change;
-            let q_next = update_position(&q_k, &v_k, &v_next, tau, theta);
-            report.impulses = impulse.lambda;
-            report.lcp_trials += impulse.trials;
-            report.lcp_residual = impulse.residual;
-            report.newton_iterations += 1;
-            iterate = (q_next, v_next);
-            // CONVERGENCE: the residual of the dynamics at the new iterate.
-            let (mass_next, forces_next) = model.dynamics(t_next, &q_next, &v_next, u);
-            let r = mass_next * (v_next - v_k)
-                + forces_k * (tau * (T::one() - theta))
-                + forces_next * (tau * theta)
-                - jac.transpose() * impulse.lambda;
-            report.newton_residual = r.norm();
-            report.converged = report.newton_residual <= p.newton_tolerance;
-            if report.converged || report.newton_iterations >= p.newton_iterations {
+            let next = self.iterate(model, &start, iterate, u)?;
+            report.record(&next.impulse);
+            report.newton_residual = self.residual(model, &start, &next, u);
+            report.converged = report.newton_residual <= self.params.newton_tolerance;
+            iterate = (next.q, next.v);
+            if report.converged || report.newton_iterations >= self.params.newton_iterations {
                 break;
             }
         }
-
-        // WRITEBACK: only a finite result replaces the caller's state.
-        let (q_next, v_next) = iterate;
-        if !(q_next.iter().chain(v_next.iter()).all(|x| x.is_finite()) && t_next.is_finite()) {
+        // WRITEBACK: only a finite result replaces the caller's state
+        let (q, v) = iterate;
+        if !(q.iter().chain(v.iter()).all(|x| x.is_finite()) && start.t_next.is_finite()) {
             return Err(StepError::NonFiniteResult);
         }
-        *state = State::new(t_next, q_next, v_next);
+        *state = State::new(start.t_next, q, v);
         Ok(report)
+    }
+
+    /// The start of a step: the index set by γ-prediction,
+    /// `h(q_k) + γ τ J(q_k) v_k ≤ 0`, and the terms every Newton iteration
+    /// reuses.
+    fn begin<M, const N: usize, const K: usize>(
+        &self,
+        model: &M,
+        state: &State<T, N>,
+        u: &M::Input,
+    ) -> Result<Start<T, N, K>, StepError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let State { t, q, v } = *state;
+        let (gaps, jac) = model.contact(&q);
+        finite_matrix(&gaps, "h")?;
+        finite_matrix(&jac, "J")?;
+        let normal_velocity = jac * v;
+        let forces = model.forces(t, &q, &v, u);
+        finite_matrix(&forces, "F")?;
+        Ok(Start {
+            t_next: t + self.params.tau,
+            q,
+            v,
+            normal_velocity,
+            forces,
+            restitution: model.restitution(),
+            active: predict_index_set(&gaps, &normal_velocity, self.params.gamma * self.params.tau),
+        })
+    }
+
+    /// One Newton iteration from the iterate `(q̃, ṽ)`: the iteration matrix
+    /// `W`, the free velocity, the impulses of the LCP, then the velocity
+    /// `v_{k+1} = v_free + W⁻¹ Jᵀ λ` and the position
+    /// `q_{k+1} = q_k + τ (θ v_{k+1} + (1 − θ) v_k)`.
+    fn iterate<M, const N: usize, const K: usize>(
+        &self,
+        model: &M,
+        start: &Start<T, N, K>,
+        (q, v): (SVector<T, N>, SVector<T, N>),
+        u: &M::Input,
+    ) -> Result<Iterate<T, N, K>, StepError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let (tau, theta) = (self.params.tau, self.params.theta);
+        let lin = model.linearization(start.t_next, &q, &v, u);
+        check_mass(&lin.mass)?;
+        finite_matrix(&lin.forces, "F")?;
+        let w = iteration_matrix(&lin.mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
+        // FREE VELOCITY: v_free = ṽ − W⁻¹ R(q̃, ṽ)
+        let residual = lin.mass * (v - start.v) + self.force_impulse(start, &lin.forces);
+        let v_free = v - solve(&w, &residual)?;
+        // IMPULSES: Newton's law compares J v_{k+1} with e u
+        let jac = model.gap_jacobian(&q);
+        finite_matrix(&jac, "J")?;
+        let approach = match self.params.approach_velocity {
+            ApproachVelocity::Start => start.normal_velocity,
+            ApproachVelocity::Iterate => jac * start.v,
+            ApproachVelocity::Slower => start.normal_velocity.sup(&(jac * start.v)),
+        };
+        let restitution_term = start.restitution.component_mul(&approach);
+        let impulse = self.solve_impulses(&w, &jac, &v_free, &restitution_term, start.active)?;
+        // UPDATE velocity, then position by the θ-method
+        let v_next = v_free + impulse.velocity_change;
+        let q_next = update_position(&start.q, &start.v, &v_next, tau, theta);
+        Ok(Iterate {
+            q: q_next,
+            v: v_next,
+            jacobian: jac,
+            impulse,
+        })
+    }
+
+    /// `τ [θ F(t_{k+1}, q, v) + (1 − θ) F(t_k, q_k, v_k)]`, from the force at
+    /// the iterate.
+    fn force_impulse<const N: usize, const K: usize>(
+        &self,
+        start: &Start<T, N, K>,
+        forces: &SVector<T, N>,
+    ) -> SVector<T, N> {
+        let (tau, theta) = (self.params.tau, self.params.theta);
+        start.forces * (tau * (T::one() - theta)) + forces * (tau * theta)
+    }
+
+    /// The Newton residual at the new iterate,
+    /// `‖M(q)(v − v_k) + τ[θ F + (1 − θ) F_k] − Jᵀλ‖₂` (as Siconos tests it).
+    fn residual<M, const N: usize, const K: usize>(
+        &self,
+        model: &M,
+        start: &Start<T, N, K>,
+        next: &Iterate<T, N, K>,
+        u: &M::Input,
+    ) -> T
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let (mass, forces) = model.dynamics(start.t_next, &next.q, &next.v, u);
+        let r = mass * (next.v - start.v) + self.force_impulse(start, &forces)
+            - next.jacobian.transpose() * next.impulse.lambda;
+        r.norm()
     }
 
     /// Solves the step's LCP on `active` and returns the impulses and the
@@ -270,8 +316,31 @@ impl<T: RealField + Copy> MoreauJean<T> {
     }
 }
 
+/// What a step keeps from its start `(t_k, q_k, v_k)`.
+struct Start<T: RealField + Copy, const N: usize, const K: usize> {
+    t_next: T,
+    q: SVector<T, N>,
+    v: SVector<T, N>,
+    /// `J(q_k) v_k`.
+    normal_velocity: SVector<T, K>,
+    /// `F(t_k, q_k, v_k)`.
+    forces: SVector<T, N>,
+    restitution: SVector<T, K>,
+    /// The index set of the step.
+    active: IndexSet,
+}
+
+/// The outcome of one Newton iteration.
+struct Iterate<T: RealField + Copy, const N: usize, const K: usize> {
+    q: SVector<T, N>,
+    v: SVector<T, N>,
+    /// `J` at the iterate the impulses acted at.
+    jacobian: SMatrix<T, K, N>,
+    impulse: Impulse<T, N, K>,
+}
+
 /// The outcome of the impact stage.
-struct Impulse<T: RealField + Copy, const N: usize, const K: usize> {
+pub(super) struct Impulse<T: RealField + Copy, const N: usize, const K: usize> {
     lambda: SVector<T, K>,
     velocity_change: SVector<T, N>,
     trials: u32,

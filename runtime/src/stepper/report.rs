@@ -43,6 +43,29 @@ pub struct StepReport<T: RealField + Copy, const K: usize> {
 }
 
 impl<T: RealField + Copy, const K: usize> StepReport<T, K> {
+    /// A report for the step ending at `t` with index set `active`, before
+    /// any iteration.
+    pub(super) fn new(t: T, active: IndexSet) -> Self {
+        Self {
+            t,
+            active,
+            impulses: SVector::zeros(),
+            lcp_trials: 0,
+            lcp_residual: T::zero(),
+            newton_iterations: 0,
+            newton_residual: T::zero(),
+            converged: false,
+        }
+    }
+
+    /// Counts one Newton iteration whose impacts were `impulse`.
+    pub(super) fn record<const N: usize>(&mut self, impulse: &super::Impulse<T, N, K>) {
+        self.impulses = impulse.lambda;
+        self.lcp_trials += impulse.trials;
+        self.lcp_residual = impulse.residual;
+        self.newton_iterations += 1;
+    }
+
     /// The constraints that received an impulse (`λ > 0`) in this step.
     pub fn impacting(&self) -> IndexSet {
         let mut set = IndexSet::new();
