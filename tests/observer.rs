@@ -1261,3 +1261,60 @@ fn glued_balls_hit_the_wall_together_in_both_observers() {
         before(&fo)
     );
 }
+
+/// Embedded targets run the observers in `f32`: Example 1 observed in
+/// `f32` (model, times, measurements) from an `f64` plant.
+///
+/// Thresholds: in `f32`, the sample times near t = 10 s are spaced by
+/// `ε₃₂ t ≈ 1e-6 s`, a relative error of 1e-3 on a 1 ms interval; times the
+/// velocity (about 10 m/s) and the injection (l_d τ = 1e-2 per sample)
+/// that is an error of up to 1e-4 m/s per sample (measured medians over
+/// [2, 10] s: 3.6e-5 reduced, 4.2e-5 full); the median must stay below
+/// 1e-3 and the error must still converge from v̂(0) = 0 (below 1e-2 m/s
+/// at 2 s, from 9.5 m/s).
+#[test]
+fn observers_run_in_f32() {
+    let model64 = Parabola::<f64>::default();
+    let model32 = Parabola::<f32>::default();
+    let data = reference::<_, 2, 2>(
+        &model64,
+        Parabola::<f64>::initial_state(),
+        1e-5,
+        100,
+        10.0,
+        &SVector::zeros(),
+    );
+    let params = ObserverParams::new(10.0_f32, 20.0);
+    let q0: SVector<f32, 2> = data.samples[0].q.cast();
+    let mut ro = ReducedOrder::<f32, 2, 2>::new(params, 0.0, q0, SVector::zeros()).unwrap();
+    let mut fo = FullOrder::<f32, 2, 2>::new(
+        params,
+        FullOrderGains::scalar(5.0, 25.0),
+        0.0,
+        q0,
+        SVector::zeros(),
+    )
+    .unwrap();
+    let (mut ro_errors, mut fo_errors) = (vec![0.0; 1], vec![0.0; 1]);
+    for s in &data.samples[1..] {
+        let q: SVector<f32, 2> = s.q.cast();
+        let a = ro
+            .update(&model32, s.t as f32, &q, &SVector::zeros())
+            .unwrap();
+        let b = fo
+            .update(&model32, s.t as f32, &q, &SVector::zeros())
+            .unwrap();
+        ro_errors.push((a.v.cast::<f64>() - s.v).norm());
+        fo_errors.push((b.v.cast::<f64>() - s.v).norm());
+    }
+    for (name, e) in [("reduced", &ro_errors), ("full", &fo_errors)] {
+        let late = figures(&window(&data, e, 2.0, 10.0));
+        let at_two = e[2000];
+        eprintln!(
+            "f32 {name}: |v − v̂| at 2 s {at_two:.1e}; over [2, 10] s median {:.1e}, p90 {:.1e}, max {:.1e}",
+            late.median, late.p90, late.max
+        );
+        assert!(at_two < 1e-2, "{name}: {at_two}");
+        assert!(late.median < 1e-3, "{name}: {late:?}");
+    }
+}
