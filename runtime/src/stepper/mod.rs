@@ -230,9 +230,9 @@ impl<T: RealField + Copy> MoreauJean<T> {
     {
         let (tau, theta) = (self.params.tau, self.params.theta);
         let lin = model.linearization(start.t_next, &q, &v, u);
-        check_mass(&lin.mass)?;
+        let mass = check_mass(&lin.mass)?;
         finite_matrix(&lin.forces, "F")?;
-        let w = iteration_matrix(&lin.mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
+        let w = iteration_matrix(&lin.mass, mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
         // FREE VELOCITY: v_free = ṽ − W⁻¹ R(q̃, ṽ)
         let residual = lin.mass * (v - start.v) + self.force_impulse(start, &lin.forces);
         let v_free = v - solve(&w, &residual)?;
@@ -290,7 +290,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
     /// velocity change `W⁻¹ Jᵀ λ` they cause.
     fn solve_impulses<const N: usize, const K: usize>(
         &self,
-        w: &Lu<T, N>,
+        w: &Factor<T, N>,
         jac: &SMatrix<T, K, N>,
         v_free: &SVector<T, N>,
         restitution_term: &SVector<T, K>,
@@ -385,26 +385,46 @@ pub fn predict_index_set<T: RealField + Copy, const K: usize>(
     set
 }
 
-/// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored.
+/// A factored iteration matrix `W`.
+enum Factor<T: RealField + Copy, const N: usize> {
+    /// `W = M` (forces that depend on neither `q` nor `v`): the Cholesky
+    /// factor the mass check already computed.
+    Mass(Cholesky<T, N>),
+    /// The general, non-symmetric `W`.
+    Lu(Lu<T, N>),
+}
+
+/// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored; `mass` is the Cholesky factor
+/// of `M`, reused when both Jacobians vanish.
 fn iteration_matrix<T: RealField + Copy, const N: usize>(
-    mass: &SMatrix<T, N, N>,
+    m: &SMatrix<T, N, N>,
+    mass: Cholesky<T, N>,
     forces_dq: &SMatrix<T, N, N>,
     forces_dv: &SMatrix<T, N, N>,
     tau: T,
     theta: T,
-) -> Result<Lu<T, N>, StepError<T>> {
+) -> Result<Factor<T, N>, StepError<T>> {
+    let zero = |a: &SMatrix<T, N, N>| a.iter().all(|x| *x == T::zero());
+    if zero(forces_dq) && zero(forces_dv) {
+        return Ok(Factor::Mass(mass));
+    }
     let h_theta = tau * theta;
-    let w = mass + forces_dv * h_theta + forces_dq * (h_theta * h_theta);
+    let w = m + forces_dv * h_theta + forces_dq * (h_theta * h_theta);
     finite_matrix(&w, "W")?;
-    Lu::new(&w).ok_or(StepError::SingularIterationMatrix)
+    Lu::new(&w)
+        .map(Factor::Lu)
+        .ok_or(StepError::SingularIterationMatrix)
 }
 
 /// `W⁻¹ x`.
 fn solve<T: RealField + Copy, const N: usize, const C: usize>(
-    w: &Lu<T, N>,
+    w: &Factor<T, N>,
     x: &SMatrix<T, N, C>,
 ) -> Result<SMatrix<T, N, C>, StepError<T>> {
-    let x = w.solve(x);
+    let x = match w {
+        Factor::Mass(chol) => chol.solve(x),
+        Factor::Lu(lu) => lu.solve(x),
+    };
     if x.iter().all(|v| v.is_finite()) {
         Ok(x)
     } else {
@@ -414,7 +434,7 @@ fn solve<T: RealField + Copy, const N: usize, const C: usize>(
 
 /// The Delassus matrix `J W⁻¹ Jᵀ` and `W⁻¹ Jᵀ`.
 fn assemble_delassus<T: RealField + Copy, const N: usize, const K: usize>(
-    w: &Lu<T, N>,
+    w: &Factor<T, N>,
     jac: &SMatrix<T, K, N>,
 ) -> Result<(SMatrix<T, K, K>, SMatrix<T, N, K>), StepError<T>> {
     let w_inv_jt = solve(w, &jac.transpose())?;
@@ -494,14 +514,12 @@ where
     Ok(())
 }
 
+/// Checks that `M` is positive definite and returns its Cholesky factor.
 fn check_mass<T: RealField + Copy, const N: usize>(
     m: &SMatrix<T, N, N>,
-) -> Result<(), StepError<T>> {
+) -> Result<Cholesky<T, N>, StepError<T>> {
     finite_matrix(m, "M")?;
-    match Cholesky::new(m) {
-        Some(_) => Ok(()),
-        None => Err(StepError::MassNotPositiveDefinite),
-    }
+    Cholesky::new(m).ok_or(StepError::MassNotPositiveDefinite)
 }
 
 fn finite_matrix<T: RealField + Copy, const R: usize, const C: usize>(
