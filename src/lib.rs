@@ -79,7 +79,7 @@ pub use moreau_runtime::*;
 /// public API: it may change in any release.
 #[doc(hidden)]
 pub mod __private {
-    pub use moreau_runtime::{Linearization, Model, ModelInfo, Terms};
+    pub use moreau_runtime::{Linearization, Model, ModelInfo, Sensitivities, Terms};
     pub use nalgebra::{ArrayStorage, RealField, SMatrix, SVector};
 
     /// Converts a literal of the model to the scalar type; exact for `f64`,

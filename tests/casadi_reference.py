@@ -194,10 +194,17 @@ def build(model: Model, cname: str):
     # The force Jacobians ∂F/∂q and ∂F/∂v (what an implicit Moreau–Jean step
     # puts in its iteration matrix); not part of the fused op count.
     dF = (ca.jacobian(F, q), ca.jacobian(F, v))
+    # What a covariance-propagating estimator needs: ∂(M v)/∂q and ∂(J v)/∂q
+    # at fixed v (CasADi's AD of the products).
+    dMv = ca.jacobian(ca.mtimes(M, v), q)
+    dJv = ca.jacobian(ca.mtimes(J, v), q) if model.k else ca.SX.zeros(0, n)
     check = ca.Function(
         f"{cname}_check",
         [cm.t, q, v, cm.u, cm.p],
-        [ca.densify(x) for x in (F_lag, Mdot - 2 * C, T0, dTdv0, terms, Mdot, C, cm.T, *dF)],
+        [
+            ca.densify(x)
+            for x in (F_lag, Mdot - 2 * C, T0, dTdv0, terms, Mdot, C, cm.T, *dF, dMv, dJv)
+        ],
     )
     return fused, check
 
@@ -270,7 +277,7 @@ def evaluate(model: Model, fused, check, pts, origin: str):
     for idx, pt in enumerate(pts):
         args = [pt["t"], pt["q"], pt["v"], pt["u"], pt["p"]]
         M, C, G, F, h, J = (_np(x) for x in fused(*args))
-        F_lag, skew, T0, dTdv0, terms, Mdot, C2, T, dFdq, dFdv = (
+        F_lag, skew, T0, dTdv0, terms, Mdot, C2, T, dFdq, dFdv, dMv, dJv = (
             _np(x) for x in check(*args)
         )
         for name, arr in (("M", M), ("C", C), ("G", G), ("F", F), ("h", h), ("J", J)):
@@ -317,6 +324,8 @@ def evaluate(model: Model, fused, check, pts, origin: str):
                 "J": _rows(J.reshape(model.k, model.n)),
                 "dFdq": _rows(dFdq),
                 "dFdv": _rows(dFdv),
+                "dMvdq": _rows(dMv),
+                "dJvdq": _rows(dJv.reshape(model.k, model.n)),
             }
         )
     if failures:

@@ -13,7 +13,7 @@
 mod common;
 
 use common::{casadi_fixture, matrix, min_eigenvalue, relative_error, vector};
-use moreau::Model;
+use moreau::{Model, Sensitivities};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector};
 
@@ -79,7 +79,7 @@ fn check_close<const R: usize, const C: usize>(
 /// Every generated method of `M` against the CasADi fixture `stem`.
 fn against_casadi<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
 where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+    M: Sensitivities<N, K> + Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
 {
     for (i, p) in points::<M, N, K, NU>(stem).iter().enumerate() {
         let at = |what: &str| format!("{stem} point {i}: {what}");
@@ -119,6 +119,11 @@ where
         check_close(&at("linearization F"), &lin.forces, &forces);
         check_close(&at("∂F/∂q"), &lin.forces_dq, &dfdq);
         check_close(&at("∂F/∂v"), &lin.forces_dv, &dfdv);
+        // the sensitivities (∂(M v)/∂q, ∂(J v)/∂q at the point's v)
+        let dmvdq: SMatrix<f64, N, N> = matrix(&p.json["dMvdq"]);
+        let djvdq: SMatrix<f64, K, N> = matrix(&p.json["dJvdq"]);
+        check_close(&at("∂(M v)/∂q"), &m.mass_dq(q, v), &dmvdq);
+        check_close(&at("∂(J v)/∂q"), &m.jacobian_dq(q, v), &djvdq);
     }
 }
 

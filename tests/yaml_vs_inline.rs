@@ -4,7 +4,7 @@
 mod common;
 
 use common::vector;
-use moreau::Model;
+use moreau::{Model, Sensitivities};
 use nalgebra::{SVector, Vector2};
 
 mod from_yaml {
@@ -164,7 +164,7 @@ fn inline_model_texts_are_the_committed_files() {
 /// models: every output, the force Jacobians included.
 fn inline_matches_casadi<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
 where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+    M: Sensitivities<N, K> + Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
 {
     let path = common::root().join(format!("tests/fixtures/inline/{stem}.json"));
     let fixture: serde_json::Value =
@@ -218,6 +218,7 @@ where
         let u: SVector<f64, NU> = vector(&point["u"]);
         let all = model.eval(t, &q, &v, &u);
         let lin = model.linearization(t, &q, &v, &u);
+        let (dmv, djv) = (model.mass_dq(&q, &v), model.jacobian_dq(&q, &v));
         for (what, ours) in [
             ("M", all.mass.as_slice()),
             ("C", all.coriolis.as_slice()),
@@ -227,6 +228,8 @@ where
             ("J", all.jacobian.as_slice()),
             ("dFdq", lin.forces_dq.as_slice()),
             ("dFdv", lin.forces_dv.as_slice()),
+            ("dMvdq", dmv.as_slice()),
+            ("dJvdq", djv.as_slice()),
         ] {
             let casadi = flat(&point[what]);
             let scale = casadi.iter().fold(0.0_f64, |m, x| m.max(x.abs()));

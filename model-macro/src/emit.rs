@@ -16,7 +16,7 @@
 
 use std::fmt::Write;
 
-use moreau_sym::{Func, Op, Operand, Schedule, VarId};
+use moreau_sym::{Func, Layout as Outputs, Op, Operand, Quantity, Schedule, Slot, VarId};
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::{format_ident, quote};
 
@@ -26,122 +26,16 @@ use crate::lower::{Layout, Lowered, Var};
 use crate::spec::{ModelSpec, Origin};
 use crate::{check, render};
 
-/// The quantities the generated code returns.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Quantity {
-    Mass,
-    Coriolis,
-    Gravity,
-    Force,
-    Gap,
-    Jacobian,
-    ForceDq,
-    ForceDv,
-}
-
-/// Where each output entry sits in the fused list.
-struct Slots {
-    n: usize,
-    k: usize,
-}
-
-impl Slots {
-    /// Number of entries of `q` (M keeps its upper triangle only).
-    fn len(&self, q: Quantity) -> usize {
-        let (n, k) = (self.n, self.k);
-        match q {
-            Quantity::Mass => n * (n + 1) / 2,
-            Quantity::Coriolis | Quantity::ForceDq | Quantity::ForceDv => n * n,
-            Quantity::Gravity | Quantity::Force => n,
-            Quantity::Gap => k,
-            Quantity::Jacobian => k * n,
-        }
-    }
-
-    const ORDER: [Quantity; 8] = [
-        Quantity::Mass,
-        Quantity::Coriolis,
-        Quantity::Gravity,
-        Quantity::Force,
-        Quantity::Gap,
-        Quantity::Jacobian,
-        Quantity::ForceDq,
-        Quantity::ForceDv,
-    ];
-
-    fn start(&self, q: Quantity) -> usize {
-        Self::ORDER
-            .iter()
-            .take_while(|&&o| o != q)
-            .map(|&o| self.len(o))
-            .sum()
-    }
-
-    /// The slot of entry `(i, j)` of `q` (`j` is ignored for vectors).
-    fn slot(&self, q: Quantity, i: usize, j: usize) -> usize {
-        let offset = match q {
-            Quantity::Mass => {
-                let (i, j) = (i.min(j), i.max(j));
-                i * self.n - i * (i + 1) / 2 + j
-            }
-            Quantity::Coriolis | Quantity::ForceDq | Quantity::ForceDv => i * self.n + j,
-            Quantity::Jacobian => i * self.n + j,
-            Quantity::Gravity | Quantity::Force | Quantity::Gap => i,
-        };
-        self.start(q) + offset
-    }
-
-    /// Every slot of `q`, in its natural order.
-    fn all(&self, q: Quantity) -> Vec<usize> {
-        let start = self.start(q);
-        (start..start + self.len(q)).collect()
-    }
-
-    /// The local name of slot `s` and the matrix entry it is, for comments.
-    fn describe(&self, s: usize) -> (String, String) {
-        let q = Self::ORDER
-            .into_iter()
-            .find(|&q| s >= self.start(q) && s < self.start(q) + self.len(q))
-            .expect("slot out of range");
-        let offset = s - self.start(q);
-        let n = self.n;
-        match q {
-            Quantity::Mass => {
-                let mut i = 0;
-                let mut rest = offset;
-                while rest >= n - i {
-                    rest -= n - i;
-                    i += 1;
-                }
-                let j = i + rest;
-                let entry = if i == j {
-                    format!("M[{i},{j}]")
-                } else {
-                    format!("M[{i},{j}] = M[{j},{i}]")
-                };
-                (format!("m_{i}_{j}"), entry)
-            }
-            Quantity::Coriolis => (
-                format!("c_{}_{}", offset / n, offset % n),
-                format!("C[{},{}]", offset / n, offset % n),
-            ),
-            Quantity::ForceDq => (
-                format!("dfdq_{}_{}", offset / n, offset % n),
-                format!("∂F[{}]/∂q[{}]", offset / n, offset % n),
-            ),
-            Quantity::ForceDv => (
-                format!("dfdv_{}_{}", offset / n, offset % n),
-                format!("∂F[{}]/∂v[{}]", offset / n, offset % n),
-            ),
-            Quantity::Jacobian => (
-                format!("j_{}_{}", offset / n, offset % n),
-                format!("J[{},{}]", offset / n, offset % n),
-            ),
-            Quantity::Gravity => (format!("g_{offset}"), format!("G[{offset}]")),
-            Quantity::Force => (format!("f_{offset}"), format!("F[{offset}]")),
-            Quantity::Gap => (format!("h_{offset}"), format!("h[{offset}]")),
-        }
-    }
+/// The local name of an output entry (`m_0_1` for `M[0,1]`, `g_2` for
+/// `G[2]`) and the entry it is, for comments.
+fn describe(slot: Slot) -> (String, String) {
+    let stem = slot.quantity.stem();
+    let name = if slot.quantity.is_vector() {
+        format!("{stem}_{}", slot.row)
+    } else {
+        format!("{stem}_{}_{}", slot.row, slot.col)
+    };
+    (name, slot.describe())
 }
 
 /// An expression of the generated code, before it becomes tokens or text.
@@ -184,7 +78,7 @@ struct Body {
 }
 
 /// Builds the body computing `slots` from the fused list.
-fn body(full: &Schedule, slots_of: &Slots, slots: &[usize]) -> Body {
+fn body(full: &Schedule, outputs_of: &Outputs, slots: &[usize]) -> Body {
     let sched = full.restrict(slots);
     let uses = sched.use_counts();
     // Names: an output names its temporary after the first slot it fills.
@@ -194,7 +88,7 @@ fn body(full: &Schedule, slots_of: &Slots, slots: &[usize]) -> Body {
         if let Operand::Tmp(t) = *out {
             let t = t as usize;
             if names[t].is_none() {
-                let (name, entry) = slots_of.describe(slot);
+                let (name, entry) = describe(outputs_of.slot(slot));
                 names[t] = Some(name);
                 entries[t] = Some(entry);
             }
@@ -360,48 +254,24 @@ fn constant_name(c: f64, index: usize) -> String {
 struct Emitter<'a> {
     spec: &'a ModelSpec,
     layout: Layout,
-    slots: Slots,
+    outputs: Outputs,
     full: Schedule,
 }
 
 impl<'a> Emitter<'a> {
     fn new(spec: &'a ModelSpec, lowered: &Lowered) -> Self {
         let mech = &lowered.mechanics;
-        let (n, k) = (spec.dofs(), spec.constraint_count());
-        let mut outputs = Vec::new();
-        for i in 0..n {
-            for j in i..n {
-                outputs.push(mech.mass[i][j]);
-            }
-        }
-        outputs.extend(mech.coriolis.iter().flatten());
-        outputs.extend(&mech.gravity);
-        outputs.extend(&mech.forces);
-        outputs.extend(&mech.gaps);
-        outputs.extend(mech.jacobian.iter().flatten());
-        outputs.extend(lowered.force_dq.iter().flatten());
-        outputs.extend(lowered.force_dv.iter().flatten());
         Emitter {
             spec,
             layout: lowered.layout,
-            slots: Slots { n, k },
-            full: Schedule::new(&lowered.graph, &outputs),
+            outputs: mech.layout(),
+            full: Schedule::new(&lowered.graph, &mech.outputs()),
         }
     }
 
     /// Slots of the fused `eval`: M, C, G, F, h, J.
     fn eval_slots(&self) -> Vec<usize> {
-        [
-            Quantity::Mass,
-            Quantity::Coriolis,
-            Quantity::Gravity,
-            Quantity::Force,
-            Quantity::Gap,
-            Quantity::Jacobian,
-        ]
-        .into_iter()
-        .flat_map(|q| self.slots.all(q))
-        .collect()
+        self.outputs.indices(&Quantity::EVAL)
     }
 
     /// The user-facing name of a model variable.
@@ -575,11 +445,11 @@ impl<'a> Emitter<'a> {
         qs: &[Quantity],
         ret: impl Fn(&dyn Fn(Quantity, usize, usize) -> TokenStream) -> TokenStream,
     ) -> TokenStream {
-        let slots: Vec<usize> = qs.iter().flat_map(|&q| self.slots.all(q)).collect();
-        let body = body(&self.full, &self.slots, &slots);
+        let slots = self.outputs.indices(qs);
+        let body = body(&self.full, &self.outputs, &slots);
         let prelude = self.prelude(&body);
-        let entry = |q: Quantity, i: usize, j: usize| {
-            let slot = self.slots.slot(q, i, j);
+        let entry = |quantity: Quantity, row: usize, col: usize| {
+            let slot = self.outputs.index(Slot { quantity, row, col });
             let pos = slots
                 .iter()
                 .position(|&s| s == slot)
@@ -646,15 +516,7 @@ impl<'a> Emitter<'a> {
                 quote!(::moreau::__private::Linearization { mass: #m, forces: #f, forces_dq: #fq, forces_dv: #fv })
             },
         );
-        let eval_qs = [
-            Quantity::Mass,
-            Quantity::Coriolis,
-            Quantity::Gravity,
-            Quantity::Force,
-            Quantity::Gap,
-            Quantity::Jacobian,
-        ];
-        let eval = self.method_body(&eval_qs, |e| {
+        let eval = self.method_body(&Quantity::EVAL, |e| {
             let m = self.matrix(n, n, |i, j| e(Quantity::Mass, i, j));
             let c = self.matrix(n, n, |i, j| e(Quantity::Coriolis, i, j));
             let g = self.matrix(n, 1, |i, _| e(Quantity::Gravity, i, 0));
@@ -662,6 +524,12 @@ impl<'a> Emitter<'a> {
             let h = self.matrix(k, 1, |i, _| e(Quantity::Gap, i, 0));
             let j = self.matrix(k, n, |i, j| e(Quantity::Jacobian, i, j));
             quote!(::moreau::__private::Terms { mass: #m, coriolis: #c, gravity: #g, forces: #f, gaps: #h, jacobian: #j })
+        });
+        let mass_dq = self.method_body(&[Quantity::MassDq], |e| {
+            self.matrix(n, n, |i, j| e(Quantity::MassDq, i, j))
+        });
+        let jacobian_dq = self.method_body(&[Quantity::JacobianDq], |e| {
+            self.matrix(k, n, |i, j| e(Quantity::JacobianDq, i, j))
         });
         let op_count = int(self.full.restrict(&self.eval_slots()).op_count());
 
@@ -804,6 +672,14 @@ impl<'a> Emitter<'a> {
                 #[inline]
                 fn eval(&self, #t: T, #q: &#vec_n, #v: &#vec_n, #u: &#input) -> ::moreau::__private::Terms<T, #n, #k> { #eval }
             }
+
+            #[allow(non_snake_case, unused_variables, clippy::all)]
+            impl<#bound> ::moreau::__private::Sensitivities<#n, #k> for #name<T> {
+                #[inline]
+                fn mass_dq(&self, #q: &#vec_n, #v: &#vec_n) -> #mat_nn { #mass_dq }
+                #[inline]
+                fn jacobian_dq(&self, #q: &#vec_n, #v: &#vec_n) -> #mat_kn { #jacobian_dq }
+            }
         }
     }
 
@@ -902,7 +778,7 @@ impl<'a> Emitter<'a> {
     /// listing the snapshot tests read.
     fn listing(&self) -> String {
         let slots = self.eval_slots();
-        let body = body(&self.full, &self.slots, &slots);
+        let body = body(&self.full, &self.outputs, &slots);
         let mut s = String::new();
         let _ = writeln!(
             s,
@@ -935,7 +811,7 @@ impl<'a> Emitter<'a> {
             );
         }
         for (slot, code) in slots.iter().zip(&body.outputs) {
-            let (name, entry) = self.slots.describe(*slot);
+            let (name, entry) = describe(self.outputs.slot(*slot));
             let text = self.code_text(code);
             if text != name {
                 let _ = writeln!(s, "// {entry} = {text}");
@@ -1016,6 +892,11 @@ pub(crate) fn fallback(spec: &ModelSpec) -> TokenStream {
             fn parameter(&self, index: usize) -> ::core::option::Option<T> { ::core::unimplemented!() }
             fn parameter_mut(&mut self, index: usize) -> ::core::option::Option<&mut T> { ::core::unimplemented!() }
         }
+        #[allow(unused_variables)]
+        impl<T: ::moreau::__private::RealField + ::core::marker::Copy> ::moreau::__private::Sensitivities<#n, #k> for #name<T> {
+            fn mass_dq(&self, q: &::moreau::__private::SVector<T, #n>, w: &::moreau::__private::SVector<T, #n>) -> ::moreau::__private::SMatrix<T, #n, #n> { ::core::unimplemented!() }
+            fn jacobian_dq(&self, q: &::moreau::__private::SVector<T, #n>, v: &::moreau::__private::SVector<T, #n>) -> ::moreau::__private::SMatrix<T, #k, #n> { ::core::unimplemented!() }
+        }
     }
 }
 
@@ -1088,23 +969,26 @@ mod tests {
     }
 
     #[test]
-    fn mass_slots_cover_the_upper_triangle_once() {
-        let slots = Slots { n: 3, k: 1 };
-        let mut seen: Vec<usize> = Vec::new();
-        for i in 0..3 {
-            for j in i..3 {
-                let s = slots.slot(Quantity::Mass, i, j);
-                assert_eq!(s, slots.slot(Quantity::Mass, j, i));
-                assert_eq!(slots.describe(s).0, format!("m_{i}_{j}"));
-                seen.push(s);
-            }
-        }
-        seen.sort();
-        assert_eq!(seen, (0..6).collect::<Vec<_>>());
-        assert_eq!(
-            slots.describe(slots.slot(Quantity::Jacobian, 0, 2)).0,
-            "j_0_2"
-        );
+    fn output_entries_are_named_after_their_slot() {
+        let outputs = Outputs::new(3, 1);
+        let m21 = Slot {
+            quantity: Quantity::Mass,
+            row: 2,
+            col: 1,
+        };
+        assert_eq!(describe(outputs.slot(outputs.index(m21))).0, "m_1_2");
+        let j02 = Slot {
+            quantity: Quantity::Jacobian,
+            row: 0,
+            col: 2,
+        };
+        assert_eq!(describe(j02), ("j_0_2".into(), "J[0,2]".into()));
+        let g1 = Slot {
+            quantity: Quantity::Gravity,
+            row: 1,
+            col: 0,
+        };
+        assert_eq!(describe(g1).0, "g_1");
     }
 
     #[test]

@@ -66,16 +66,11 @@ impl Layout {
     }
 }
 
-/// The lowered model: its graph, variable layout, derived mechanics and the
-/// Jacobians of the total force.
+/// The lowered model: its graph, variable layout and derived mechanics.
 pub(crate) struct Lowered {
     pub graph: Graph,
     pub layout: Layout,
     pub mechanics: Mechanics,
-    /// `∂F/∂q`, row `i` = `∇_q F_i`.
-    pub force_dq: Vec<Vec<Id>>,
-    /// `∂F/∂v`, row `i` = `∇_v F_i`.
-    pub force_dv: Vec<Vec<Id>>,
 }
 
 /// Builds the graph and derives the mechanics. Records an error and returns
@@ -134,21 +129,10 @@ pub(crate) fn lower(cx: &Ctxt, spec: &ModelSpec) -> Option<Lowered> {
             return None;
         }
     };
-    let jacobian = |graph: &mut Graph, wrt: &[VarId]| -> Vec<Vec<Id>> {
-        mechanics
-            .forces
-            .iter()
-            .map(|&f| wrt.iter().map(|&x| graph.diff(f, x)).collect())
-            .collect()
-    };
-    let force_dq = jacobian(&mut graph, &q);
-    let force_dv = jacobian(&mut graph, &v);
     Some(Lowered {
         graph,
         layout,
         mechanics,
-        force_dq,
-        force_dv,
     })
 }
 

@@ -16,7 +16,7 @@ mod observer;
 mod stepper;
 
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
-pub use model::{Linearization, Model, ModelInfo, Terms};
+pub use model::{Linearization, Model, ModelInfo, Sensitivities, Terms};
 pub use observer::{
     Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
     ObserverError, ObserverParams, ReducedOrder, UpdateReport,

@@ -254,3 +254,66 @@ pub trait Model<const N: usize, const K: usize> {
         }
     }
 }
+
+/// The second derivatives a covariance-propagating estimator needs: the
+/// Jacobian of the free acceleration `a = −M⁻¹(q) F` and the saltation
+/// matrix of Newton's impact law, without differentiating numerically.
+///
+/// With `a = −M⁻¹ F`, `∂a/∂q = −M⁻¹ (∂(M w)/∂q|_{w = a} + ∂F/∂q)` and
+/// `∂a/∂v = −M⁻¹ ∂F/∂v`; the impact law `J(q) v⁺ = −e J(q) v⁻` moved with
+/// the configuration needs `∂(J(q) v)/∂q`. `model!` generates both from the
+/// same instruction list as the rest of the model; a hand-written model
+/// implements this trait only if it is used with such an estimator.
+///
+/// ```
+/// use moreau_runtime::{Model, ModelInfo, Sensitivities};
+/// use nalgebra::{SMatrix, SVector, Vector1, Matrix1};
+///
+/// /// A unit mass on a line whose gap is `1 − y²` (a wall at `|y| = 1`).
+/// struct Slot;
+///
+/// impl Model<1, 1> for Slot {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 1> = ModelInfo {
+///         name: "Slot", coordinates: ["y"], velocities: ["vy"], constraints: ["walls"],
+///         parameters: &[], inputs: &[], source: "", op_count: 1,
+///     };
+///     fn mass(&self, _q: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _q: &Vector1<f64>, _v: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, _q: &Vector1<f64>) -> Vector1<f64> { Vector1::zeros() }
+///     fn forces(&self, _t: f64, _q: &Vector1<f64>, _v: &Vector1<f64>, _u: &SVector<f64, 0>) -> Vector1<f64> {
+///         Vector1::zeros()
+///     }
+///     fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> { Vector1::new(1.0 - q[0] * q[0]) }
+///     fn gap_jacobian(&self, q: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(-2.0 * q[0]) }
+///     fn restitution(&self) -> Vector1<f64> { Vector1::new(1.0) }
+///     fn parameter(&self, _index: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _index: usize) -> Option<&mut f64> { None }
+/// }
+///
+/// impl Sensitivities<1, 1> for Slot {
+///     fn mass_dq(&self, _q: &Vector1<f64>, _w: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn jacobian_dq(&self, _q: &Vector1<f64>, v: &Vector1<f64>) -> Matrix1<f64> {
+///         Matrix1::new(-2.0 * v[0]) // ∂(−2 y v)/∂y
+///     }
+/// }
+///
+/// assert_eq!(Slot.jacobian_dq(&Vector1::new(0.5), &Vector1::new(3.0))[0], -6.0);
+/// ```
+pub trait Sensitivities<const N: usize, const K: usize>: Model<N, K> {
+    /// `∂(M(q) w)/∂q` at fixed `w`: entry `(i, j)` is `Σ_k ∂M_ik/∂q_j w_k`.
+    fn mass_dq(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+        w: &SVector<Self::Scalar, N>,
+    ) -> SMatrix<Self::Scalar, N, N>;
+
+    /// `∂(J(q) v)/∂q` at fixed `v`: entry `(i, j)` is
+    /// `Σ_k ∂²h_i/∂q_j ∂q_k v_k`.
+    fn jacobian_dq(
+        &self,
+        q: &SVector<Self::Scalar, N>,
+        v: &SVector<Self::Scalar, N>,
+    ) -> SMatrix<Self::Scalar, K, N>;
+}

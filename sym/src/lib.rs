@@ -11,11 +11,11 @@
 //! | [`graph`] | [`Graph`]: hash-consed arena, simplifying builders, queries |
 //! | [`diff`] | [`Graph::diff`]: exact derivatives, one rule per node |
 //! | [`eval`] | [`Graph::eval`]: the reference interpreter |
-//! | [`mechanics`] | [`Mechanics::derive`]: `M`, `C`, `G`, `F`, `J` from `T`, `V`, `Q`, `h` |
+//! | [`mechanics`] | [`Mechanics::derive`]: `M`, `C`, `G`, `F`, `J` and their derivatives from `T`, `V`, `Q`, `h`; [`Layout`], the one list of outputs |
 //! | [`schedule`] | [`Schedule`]: one CSE'd instruction list for all outputs |
 //!
 //! ```
-//! use moreau_sym::{Graph, Lagrangian, Mechanics, Schedule, VarId};
+//! use moreau_sym::{Graph, Lagrangian, Mechanics, Quantity, Schedule, VarId};
 //!
 //! // A pendulum: q = th, v = w, parameters m, l, g.
 //! let (th, w, m, l, g) = (VarId(0), VarId(1), VarId(2), VarId(3), VarId(4));
@@ -36,8 +36,9 @@
 //! let sys = Lagrangian { q: &[th], v: &[w], kinetic: t, potential: v, forces: &[], gaps: &[] };
 //! let mech = Mechanics::derive(&mut gr, &sys).unwrap();
 //!
-//! let outputs: Vec<_> = mech.flat().into_iter().map(|(_, id)| id).collect();
-//! let sched = Schedule::new(&gr, &outputs);
+//! let fused = Schedule::new(&gr, &mech.outputs());
+//! // the fused evaluation: M, C, G, F (the pendulum has no gaps)
+//! let sched = fused.restrict(&mech.layout().indices(&Quantity::EVAL));
 //! let names = |v: VarId| ["th", "w", "m", "l", "g"][v.index()].to_string();
 //! assert_eq!(
 //!     sched.listing(&names),
@@ -59,6 +60,6 @@ pub mod schedule;
 mod testing;
 
 pub use graph::Graph;
-pub use mechanics::{Lagrangian, Mechanics, MechanicsError, Quantity, Slot};
+pub use mechanics::{Lagrangian, Layout, Mechanics, MechanicsError, Quantity, Slot};
 pub use node::{Func, Id, Node, Op, VarId};
 pub use schedule::{Instr, Operand, Schedule};

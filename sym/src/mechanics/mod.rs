@@ -1,0 +1,428 @@
+//! Lagrangian mechanics: from `T`, `V`, `Q` and `h` to `M`, `C`, `G`, `F`, `J`.
+//!
+//! For coordinates `q`, velocities `v`, kinetic energy `T(q, v) = ½ vᵀ M(q) v`,
+//! potential `V(q)`, extra generalized forces `Q` and gaps `h(q) ≥ 0`, the
+//! equations of motion are `M(q) v̇ + F = 0` (the paper's (8)) with
+//!
+//! | quantity | formula |
+//! |---|---|
+//! | momentum | `p = ∂T/∂v` |
+//! | mass matrix | `M_ij = ∂p_i/∂v_j`, symmetric, built for `i ≤ j` only |
+//! | Coriolis matrix | `C_ij = Σ_k Γ_ijk v_k`, `Γ_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)` |
+//! | gravity | `G = ∂V/∂q` |
+//! | total force | `F = C v + G − Q` |
+//! | gap Jacobian | `J_ij = ∂h_i/∂q_j` |
+//!
+//! With the Christoffel symbols `Γ`, `Ṁ − 2C` is skew-symmetric, which the
+//! observers' passivity argument needs.
+//!
+//! # Work sharing
+//!
+//! `T` is differentiated once per velocity (`p`), and `M` is differentiated
+//! from `p`, not from `T` again. The `N²(N+1)/2` derivatives `∂M_ij/∂q_k`
+//! (`i ≤ j`) are built once and shared by all Christoffel symbols; within one
+//! symbol equal derivatives are merged before anything is built (so
+//! `∂M_01/∂q_0 − ∂M_10/∂q_0` is never formed), and zero derivatives vanish.
+//! `C v` reuses the entries of `C`. Zero entries stay the constant `0`, which
+//! the emitter writes as a literal.
+//!
+//! # Quadratic kinetic energy
+//!
+//! `T` must be a quadratic form in `v`: `T = ½ vᵀ M(q) v` with no term linear
+//! in `v` and no term free of `v` (such terms would be gyroscopic forces or a
+//! potential that `F = C v + G − Q` does not contain). [`Mechanics::derive`]
+//! checks, in this order, that no `M_ij` depends on a velocity
+//! ([`MechanicsError::NotQuadratic`]: `T = vx^4`, `T = vx * vy * vx`), that
+//! `∂T/∂v_k` vanishes at `v = 0` ([`MechanicsError::LinearTerm`]:
+//! `T = m * vx^2 + vx`) and that `T` vanishes at `v = 0`
+//! ([`MechanicsError::VelocityFreeTerm`]: `T = m * vx^2 + y`). Together they
+//! are equivalent to `T − ½ vᵀ M v = 0`. The checks are symbolic: the
+//! velocities are replaced by `0` and the result must simplify to the
+//! constant `0`, so a term that vanishes only through an identity the
+//! builders do not know (`sin²+cos²−1`) is reported. That `V`, `h` and the
+//! definitions do not depend on velocities is checked by the macro.
+
+use core::fmt;
+
+mod layout;
+mod lincomb;
+
+pub use layout::{Layout, Quantity, Slot};
+
+use crate::graph::Graph;
+use crate::node::{Id, VarId};
+use lincomb::{lincomb, sum};
+
+/// The inputs of [`Mechanics::derive`]: a Lagrangian system with unilateral
+/// constraints, as expressions of one [`Graph`].
+#[derive(Clone, Copy, Debug)]
+pub struct Lagrangian<'a> {
+    /// The coordinates `q`, in order.
+    pub q: &'a [VarId],
+    /// The velocities `v`, `v[i]` the rate of `q[i]`.
+    pub v: &'a [VarId],
+    /// The kinetic energy `T(q, v)`, a quadratic form in `v`.
+    pub kinetic: Id,
+    /// The potential energy `V(q)`.
+    pub potential: Id,
+    /// The extra generalized forces `Q`, one per coordinate, or empty for
+    /// none.
+    pub forces: &'a [Id],
+    /// The gaps `h_i(q) ≥ 0`.
+    pub gaps: &'a [Id],
+}
+
+/// Why a system was rejected. Indices refer to the order of
+/// [`Lagrangian::q`] and [`Lagrangian::v`].
+///
+/// ```
+/// use moreau_sym::{Graph, Lagrangian, Mechanics, MechanicsError, VarId};
+/// let mut g = Graph::new();
+/// let vx = g.var(VarId(1));
+/// let t = g.powi(vx, 4);
+/// let zero = g.constant(0.0);
+/// let sys = Lagrangian {
+///     q: &[VarId(0)],
+///     v: &[VarId(1)],
+///     kinetic: t,
+///     potential: zero,
+///     forces: &[],
+///     gaps: &[],
+/// };
+/// let err = Mechanics::derive(&mut g, &sys).unwrap_err();
+/// assert_eq!(err, MechanicsError::NotQuadratic { row: 0, col: 0, velocity: 0 });
+/// assert_eq!(err.describe(&["vx"]), "the kinetic energy is not quadratic in the \
+///     velocities: M[0,0] = ∂²T/∂vx∂vx depends on vx");
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MechanicsError {
+    /// `M[row, col] = ∂²T/∂v_row ∂v_col` depends on `v[velocity]`, so `T` has
+    /// terms of degree three or more in `v` (or is not polynomial in `v`).
+    NotQuadratic {
+        /// Row of the mass matrix entry.
+        row: usize,
+        /// Column of the mass matrix entry (`row ≤ col`).
+        col: usize,
+        /// The velocity it depends on.
+        velocity: usize,
+    },
+    /// `T` has a term linear in `v[velocity]`: `∂T/∂v_velocity` does not
+    /// vanish at `v = 0`.
+    LinearTerm {
+        /// The velocity of the linear term.
+        velocity: usize,
+    },
+    /// `T` does not vanish at `v = 0`: it has a term free of velocities.
+    VelocityFreeTerm,
+    /// A slice of [`Lagrangian`] has the wrong length.
+    Shape {
+        /// The field: `"v"` or `"forces"`.
+        what: &'static str,
+        /// The length it should have (the number of coordinates).
+        expected: usize,
+        /// Its length.
+        found: usize,
+    },
+}
+
+impl MechanicsError {
+    /// The message, naming velocities by `velocity_names[k]` (the error's
+    /// [`Display`](fmt::Display) writes `v0`, `v1`, ...).
+    #[must_use]
+    pub fn describe(&self, velocity_names: &[&str]) -> String {
+        let name = |k: usize| {
+            velocity_names
+                .get(k)
+                .map_or_else(|| format!("v{k}"), |n| (*n).to_string())
+        };
+        match *self {
+            MechanicsError::NotQuadratic { row, col, velocity } => format!(
+                "the kinetic energy is not quadratic in the velocities: \
+                 M[{row},{col}] = ∂²T/∂{}∂{} depends on {}",
+                name(row),
+                name(col),
+                name(velocity)
+            ),
+            MechanicsError::LinearTerm { velocity } => format!(
+                "the kinetic energy has a term linear in {}: T must be a quadratic \
+                 form ½ vᵀ M(q) v, without terms of degree 1 in the velocities",
+                name(velocity)
+            ),
+            MechanicsError::VelocityFreeTerm => "the kinetic energy has a term free of \
+                 velocities: T must vanish when the velocities do (move position-only \
+                 terms to the potential, with the opposite sign)"
+                .to_string(),
+            MechanicsError::Shape {
+                what,
+                expected,
+                found,
+            } => format!("`{what}` has {found} entries, expected {expected}"),
+        }
+    }
+}
+
+impl fmt::Display for MechanicsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.describe(&[]))
+    }
+}
+
+impl std::error::Error for MechanicsError {}
+
+/// The derived quantities of a [`Lagrangian`] system, as expressions of the
+/// graph they were derived in.
+///
+/// Matrices are rows of entries. `mass[i][j]` and `mass[j][i]` are the same
+/// node. Entries that are identically zero are the constant `0`.
+///
+/// ```
+/// use moreau_sym::{Graph, Lagrangian, Mechanics, VarId};
+/// // A unit mass on a line, a spring to the origin, a floor at x = 0.
+/// let (x, vx, m, k) = (VarId(0), VarId(1), VarId(2), VarId(3));
+/// let mut g = Graph::new();
+/// let (xe, ve, me, ke) = (g.var(x), g.var(vx), g.var(m), g.var(k));
+/// let half = g.constant(0.5);
+/// let v2 = g.powi(ve, 2);
+/// let t = g.mul(me, v2);
+/// let t = g.mul(half, t); // T = ½ m vx²
+/// let x2 = g.powi(xe, 2);
+/// let v = g.mul(ke, x2);
+/// let v = g.mul(half, v); // V = ½ k x²
+/// let sys = Lagrangian { q: &[x], v: &[vx], kinetic: t, potential: v, forces: &[], gaps: &[xe] };
+/// let mech = Mechanics::derive(&mut g, &sys).unwrap();
+/// assert_eq!(mech.mass, vec![vec![me]]);
+/// assert!(g.is_zero(mech.coriolis[0][0]));
+/// assert_eq!(mech.gravity[0], g.mul(ke, xe)); // k x
+/// assert_eq!(mech.forces, mech.gravity);
+/// assert!(g.as_const(mech.jacobian[0][0]) == Some(1.0));
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Mechanics {
+    /// The generalized momentum `p = ∂T/∂v = M v`.
+    pub momentum: Vec<Id>,
+    /// The mass matrix `M = ∂²T/∂v²`, `N × N`, symmetric.
+    pub mass: Vec<Vec<Id>>,
+    /// The Coriolis matrix `C`, `N × N`, from the Christoffel symbols.
+    pub coriolis: Vec<Vec<Id>>,
+    /// The gravity vector `G = ∂V/∂q`.
+    pub gravity: Vec<Id>,
+    /// The total force `F = C v + G − Q`.
+    pub forces: Vec<Id>,
+    /// The gaps `h`, as given.
+    pub gaps: Vec<Id>,
+    /// The gap Jacobian `J = ∂h/∂q`, `K × N`.
+    pub jacobian: Vec<Vec<Id>>,
+    /// `∂F/∂q`, `N × N`, row `i` = `∇_q F_i`.
+    pub force_dq: Vec<Vec<Id>>,
+    /// `∂F/∂v`, `N × N`, row `i` = `∇_v F_i`.
+    pub force_dv: Vec<Vec<Id>>,
+    /// `∂(M v)/∂q` at fixed `v`, `N × N`: `Σ_k ∂M_ik/∂q_j v_k`.
+    pub mass_dq: Vec<Vec<Id>>,
+    /// `∂(J v)/∂q` at fixed `v`, `K × N`: `Σ_k ∂J_ik/∂q_j v_k`.
+    pub jacobian_dq: Vec<Vec<Id>>,
+}
+
+impl Mechanics {
+    /// Derives `M`, `C`, `G`, `F` and `J` of `sys` in `g`, after checking
+    /// that `T` is a quadratic form in `v` (see the [module docs](self)).
+    ///
+    /// # Errors
+    /// [`MechanicsError::Shape`] if `v` or `forces` (unless empty) do not have
+    /// one entry per coordinate; [`MechanicsError::NotQuadratic`],
+    /// [`MechanicsError::LinearTerm`] or [`MechanicsError::VelocityFreeTerm`]
+    /// if `T` is not a quadratic form in `v`.
+    // Index loops mirror the formulas' indices (M_ij, Γ_ijk).
+    #[allow(clippy::needless_range_loop)]
+    pub fn derive(g: &mut Graph, sys: &Lagrangian<'_>) -> Result<Mechanics, MechanicsError> {
+        let n = sys.q.len();
+        for (what, found) in [("v", sys.v.len()), ("forces", sys.forces.len())] {
+            if found != n && !(what == "forces" && found == 0) {
+                return Err(MechanicsError::Shape {
+                    what,
+                    expected: n,
+                    found,
+                });
+            }
+        }
+        let zero = g.constant(0.0);
+
+        // p = ∂T/∂v, M_ij = ∂p_i/∂v_j for i ≤ j.
+        let momentum = g.gradient(sys.kinetic, sys.v);
+        let mut mass = vec![vec![zero; n]; n];
+        for i in 0..n {
+            for j in i..n {
+                let m = g.diff(momentum[i], sys.v[j]);
+                if let Some(k) = sys.v.iter().position(|&v| g.depends_on(m, v)) {
+                    return Err(MechanicsError::NotQuadratic {
+                        row: i,
+                        col: j,
+                        velocity: k,
+                    });
+                }
+                mass[i][j] = m;
+                mass[j][i] = m;
+            }
+        }
+        check_form(g, sys, &momentum)?;
+
+        // dm[i][j][k] = ∂M_ij/∂q_k, for i ≤ j (and mirrored).
+        let mut dm = vec![vec![Vec::new(); n]; n];
+        for i in 0..n {
+            for j in i..n {
+                let d = g.gradient(mass[i][j], sys.q);
+                dm[j][i].clone_from(&d);
+                dm[i][j] = d;
+            }
+        }
+        let mut coriolis = vec![vec![zero; n]; n];
+        for (i, row) in coriolis.iter_mut().enumerate() {
+            for (j, c) in row.iter_mut().enumerate() {
+                let mut terms = Vec::new();
+                for k in 0..n {
+                    let gamma = lincomb(
+                        g,
+                        &[(0.5, dm[i][j][k]), (0.5, dm[i][k][j]), (-0.5, dm[j][k][i])],
+                    );
+                    if !g.is_zero(gamma) {
+                        let vk = g.var(sys.v[k]);
+                        terms.push(g.mul(gamma, vk));
+                    }
+                }
+                *c = sum(g, &terms);
+            }
+        }
+
+        let gravity = g.gradient(sys.potential, sys.q);
+        let mut forces = Vec::with_capacity(n);
+        for i in 0..n {
+            let mut terms = Vec::new();
+            for j in 0..n {
+                if !g.is_zero(coriolis[i][j]) {
+                    let vj = g.var(sys.v[j]);
+                    terms.push(g.mul(coriolis[i][j], vj));
+                }
+            }
+            let cv = sum(g, &terms);
+            let f = g.add(cv, gravity[i]);
+            forces.push(match sys.forces.get(i) {
+                Some(&q) => g.sub(f, q),
+                None => f,
+            });
+        }
+        let jacobian = g.jacobian(sys.gaps, sys.q);
+        let force_dq = g.jacobian(&forces, sys.q);
+        let force_dv = g.jacobian(&forces, sys.v);
+        // ∂(M v)_i/∂q_j = Σ_k ∂M_ik/∂q_j v_k, from the shared ∂M/∂q.
+        let contract = |g: &mut Graph, d: &dyn Fn(usize) -> Id, k_max: usize| {
+            let mut terms = Vec::new();
+            for k in 0..k_max {
+                if !g.is_zero(d(k)) {
+                    let vk = g.var(sys.v[k]);
+                    terms.push(g.mul(d(k), vk));
+                }
+            }
+            sum(g, &terms)
+        };
+        let mass_dq = (0..n)
+            .map(|i| (0..n).map(|j| contract(g, &|k| dm[i][k][j], n)).collect())
+            .collect();
+        let jacobian_dq = jacobian
+            .iter()
+            .map(|row: &Vec<Id>| {
+                let d: Vec<Vec<Id>> = row.iter().map(|&jk| g.gradient(jk, sys.q)).collect();
+                (0..n).map(|j| contract(g, &|k| d[k][j], n)).collect()
+            })
+            .collect();
+        Ok(Mechanics {
+            momentum,
+            mass,
+            coriolis,
+            gravity,
+            forces,
+            gaps: sys.gaps.to_vec(),
+            jacobian,
+            force_dq,
+            force_dv,
+            mass_dq,
+            jacobian_dq,
+        })
+    }
+
+    /// The layout of this system's outputs.
+    #[must_use]
+    pub fn layout(&self) -> Layout {
+        Layout::new(self.mass.len(), self.gaps.len())
+    }
+
+    /// The expression of one entry.
+    ///
+    /// # Panics
+    /// If the slot is outside the quantity's shape.
+    #[must_use]
+    pub fn get(&self, slot: Slot) -> Id {
+        let (i, j) = (slot.row, slot.col);
+        match slot.quantity {
+            Quantity::Mass => self.mass[i][j],
+            Quantity::Coriolis => self.coriolis[i][j],
+            Quantity::Gravity => self.gravity[i],
+            Quantity::Force => self.forces[i],
+            Quantity::Gap => self.gaps[i],
+            Quantity::Jacobian => self.jacobian[i][j],
+            Quantity::ForceDq => self.force_dq[i][j],
+            Quantity::ForceDv => self.force_dv[i][j],
+            Quantity::MassDq => self.mass_dq[i][j],
+            Quantity::JacobianDq => self.jacobian_dq[i][j],
+        }
+    }
+
+    /// Every output in the order of [`Layout`]: entry `k` is the expression
+    /// of [`Layout::slot`]`(k)`. This is the list the fused schedule is built
+    /// from; a method's schedule is
+    /// [`Schedule::restrict`](crate::Schedule::restrict) to
+    /// [`Layout::indices`] of its quantities.
+    ///
+    /// ```
+    /// use moreau_sym::{Graph, Lagrangian, Mechanics, Quantity, Schedule, VarId};
+    /// let mut g = Graph::new();
+    /// let v = g.var(VarId(1));
+    /// let t = g.powi(v, 2); // T = v², M = 2
+    /// let zero = g.constant(0.0);
+    /// let sys = Lagrangian { q: &[VarId(0)], v: &[VarId(1)], kinetic: t, potential: zero, forces: &[], gaps: &[] };
+    /// let mech = Mechanics::derive(&mut g, &sys).unwrap();
+    /// let outputs = mech.outputs();
+    /// assert_eq!(outputs.len(), 7); // M, C, G, F, ∂F/∂q, ∂F/∂v, ∂(Mv)/∂q
+    /// let fused = Schedule::new(&g, &outputs);
+    /// let mass = mech.layout().indices(&[Quantity::Mass]);
+    /// assert_eq!(fused.restrict(&mass).eval(&[0.0, 0.0]), vec![2.0]);
+    /// ```
+    #[must_use]
+    pub fn outputs(&self) -> Vec<Id> {
+        let layout = self.layout();
+        Quantity::ALL
+            .iter()
+            .flat_map(|&q| layout.slots(q))
+            .map(|slot| self.get(slot))
+            .collect()
+    }
+}
+
+/// Checks that `T = ½ vᵀ M v` given that `M` is free of velocities: `p` and
+/// `T` must vanish at `v = 0`.
+fn check_form(g: &mut Graph, sys: &Lagrangian<'_>, momentum: &[Id]) -> Result<(), MechanicsError> {
+    let zero = g.constant(0.0);
+    let at_rest: Vec<(VarId, Id)> = sys.v.iter().map(|&v| (v, zero)).collect();
+    for (k, &p) in momentum.iter().enumerate() {
+        let p0 = g.subst(p, &at_rest);
+        if !g.is_zero(p0) {
+            return Err(MechanicsError::LinearTerm { velocity: k });
+        }
+    }
+    let t0 = g.subst(sys.kinetic, &at_rest);
+    if !g.is_zero(t0) {
+        return Err(MechanicsError::VelocityFreeTerm);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;
