@@ -9,7 +9,7 @@ parameters ``p``, and computes with CasADi's own differentiation:
 
 * ``M = ∂²T/∂v²`` (``casadi.hessian``),
 * ``C_ij = Σ_k ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i) v_k`` (Christoffel),
-* ``G = ∂V/∂q``, ``F = C v + G − Q`` (``Q`` from ``forces``, 0 where missing),
+* ``G = ∂V/∂q``, ``F = C v + G − Q`` (``Q`` from ``applied``, 0 where missing),
 * ``h`` and ``J = ∂h/∂q`` (row ``i`` is ``∇h_iᵀ``).
 
 Internal checks at every sample point (the script fails if one does not hold):

@@ -21,7 +21,7 @@ that an edited model cannot silently drift away from its reference):
   tau = 1e-3, final time 10 s.
 * ``double_pendulum``: absolute angles th1, th2 from the downward vertical,
   point masses m1, m2 at the ends of massless links l1, l2, joint damping as
-  the YAML's ``forces``; h_wall = wall - x_tip, h_floor = y_tip + floor,
+  the YAML's ``applied``; h_wall = wall - x_tip, h_floor = y_tip + floor,
   e = 0.8, tau = 1e-3, final time 5 s.
 
 Both are simulated with Siconos' ``MoreauJeanOSI(theta=0.5, gamma=0.5)`` in a
@@ -171,9 +171,9 @@ def _check_common(doc, fname, coords, params, kinetic, potential, constraints,
            "%s constraints %r" % (fname, got))
     _check(float(doc["restitution"]) == restitution,
            "%s restitution %r" % (fname, doc["restitution"]))
-    got_forces = {k: _norm(v) for k, v in (doc.get("forces") or {}).items()}
+    got_forces = {k: _norm(v) for k, v in (doc.get("applied") or {}).items()}
     _check(got_forces == {k: _norm(v) for k, v in (forces or {}).items()},
-           "%s forces %r" % (fname, doc.get("forces")))
+           "%s applied forces %r" % (fname, doc.get("applied")))
 
 
 class Parabola:

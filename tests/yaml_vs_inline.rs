@@ -43,7 +43,7 @@ mod cart_pole {
         let bob_vy = l * sin(th) * dth;
         kinetic = 0.5 * mc * ds^2 + 0.5 * mp * (bob_vx^2 + bob_vy^2);
         potential = -mp * g * l * cos(th);
-        forces { s: u - b * ds }
+        applied { s: u - b * ds }
         constraints {
             #[restitution = 0.5]
             left: bob_x >= -w,
@@ -69,7 +69,7 @@ mod function_zoo {
             + 0.05 * m * sinh(0.2 * a) * da * db;
         potential = k * (sqrt(r2) + ln(r2) + exp(-0.1 * a^2) + tan(0.3 * b) + atan2(b, 3 + a))
             + a^4 / 4 + r2^0.75;
-        forces { a: u * cos(w * t + pi / 4) - 0.1 * da * db^2, b: -0.2 * db^3 }
+        applied { a: u * cos(w * t + pi / 4) - 0.1 * da * db^2, b: -0.2 * db^3 }
     }
 }
 

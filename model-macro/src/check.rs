@@ -1,63 +1,52 @@
-//! Validation of a [`ModelSpec`]: one `check_*` function per rule, its rule
-//! in the comment above it. Checks only record errors; they never stop each
-//! other, so every mistake is reported at once.
+//! Validation: one `check_*` function per rule, its rule in the comment
+//! above it. Checks only record errors; they never stop each other, so
+//! every mistake is reported at once.
 //!
-//! The one rule that needs calculus, "`T` is quadratic in `v`", is checked
-//! while lowering (`lower.rs`), where the derivatives exist.
+//! Names are looked up in the model's one [`Scope`] (a hash map built
+//! once). The rules that need calculus ("`T` is quadratic in `v`", "`M` has
+//! a positive diagonal", "`h` depends on `q`") are checked while lowering,
+//! where the derivatives exist.
 
-use crate::ctxt::{Ctxt, Loc};
+use std::collections::HashSet;
+
+use crate::ctxt::Ctxt;
 use crate::expr::Expr;
-use crate::front::keys;
-use crate::spec::{ModelSpec, Name, RESERVED, Symbol};
+use crate::keys;
+use crate::loc::Loc;
+use crate::resolve::{Scope, Symbol, Var};
+use crate::spec::{ModelSpec, Name, PRELUDE_VALUES, RESERVED, RUST_KEYWORDS, is_identifier};
 
 /// Runs every check.
-pub(crate) fn check(cx: &Ctxt, spec: &ModelSpec) {
+pub(crate) fn check(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     check_name_forms(cx, spec);
     check_duplicates(cx, spec);
     check_coordinates_present(cx, spec);
-    check_unknown_names(cx, spec);
-    check_dependencies(cx, spec);
-    check_forces(cx, spec);
+    check_unknown_names(cx, spec, scope);
+    check_dependencies(cx, spec, scope);
+    check_applied(cx, spec, scope);
     check_restitution(cx, spec);
-    check_initial(cx, spec);
+    check_initial(cx, spec, scope);
     check_numbers_finite(cx, spec);
 }
 
-const RUST_KEYWORDS: [&str; 52] = [
-    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for",
-    "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return",
-    "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe", "use", "where",
-    "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final", "macro",
-    "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
-];
-
-/// Whether `text` can name a field of the generated type: an identifier,
-/// not a keyword, not reserved.
-pub(crate) fn is_field_name(text: &str) -> bool {
-    is_identifier(text)
-        && !RUST_KEYWORDS.contains(&text)
-        && !RESERVED.contains(&text)
-        && text != keys::RESTITUTION
-        && !text.starts_with("__")
-}
-
-fn is_identifier(text: &str) -> bool {
-    let mut chars = text.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-        && text != "_"
-}
-
 // Every declared name becomes a Rust identifier (a field, a binding or the
-// type), so it must be one and must not be a keyword; `t` and `pi` are the
-// language's own; a parameter may not be called `restitution` (that field
-// holds the coefficients); names starting with `__` are left to the macro.
+// type), so it must be one (ASCII: see `spec::is_identifier`) and must not
+// be a keyword or a prelude value (`let None = …` is a pattern); `t` and
+// `pi` are the language's own; a parameter may not be called `restitution`
+// (that field holds the coefficients); the model may not be called `T`
+// (its scalar type parameter); names starting with `__` are left to the
+// macro.
 fn check_name_forms(cx: &Ctxt, spec: &ModelSpec) {
     let check = |name: &Name, what: &str| {
         if !is_identifier(&name.text) {
             cx.error(
                 name.loc,
                 format!("`{}` cannot name {what}: names are letters, digits and `_`, not starting with a digit", name.text),
+            );
+        } else if PRELUDE_VALUES.contains(&name.text.as_str()) {
+            cx.error(
+                name.loc,
+                format!("`{}` is a value of Rust's prelude and cannot name {what}: the generated code would read it as that value", name.text),
             );
         } else if RUST_KEYWORDS.contains(&name.text.as_str()) {
             cx.error(
@@ -73,6 +62,11 @@ fn check_name_forms(cx: &Ctxt, spec: &ModelSpec) {
     };
     if spec.name.text.is_empty() {
         // a missing name is reported by the front end
+    } else if spec.name.text == "T" {
+        cx.error(
+            spec.name.loc,
+            "`T` cannot name the model: the generated type is generic over its scalar, called `T`",
+        );
     } else {
         check(&spec.name, "the model");
     }
@@ -98,14 +92,7 @@ fn check_name_forms(cx: &Ctxt, spec: &ModelSpec) {
     for c in &spec.constraints {
         check(&c.name, "a constraint");
     }
-    let declared = spec
-        .coordinates
-        .iter()
-        .flat_map(|c| [&c.q, &c.v])
-        .chain(spec.parameters.iter().map(|p| &p.name))
-        .chain(spec.inputs.iter())
-        .chain(spec.definitions.iter().map(|d| &d.name));
-    for name in declared {
+    for (name, _) in spec.declared() {
         if RESERVED.contains(&name.text.as_str()) {
             cx.error(
                 name.loc,
@@ -127,16 +114,9 @@ fn check_name_forms(cx: &Ctxt, spec: &ModelSpec) {
 // namespace (expressions refer to all of them by name); constraint names must
 // differ from each other.
 fn check_duplicates(cx: &Ctxt, spec: &ModelSpec) {
-    let mut seen: Vec<(&Name, &str)> = Vec::new();
-    let symbols = spec
-        .coordinates
-        .iter()
-        .flat_map(|c| [(&c.q, "a coordinate"), (&c.v, "a velocity")])
-        .chain(spec.parameters.iter().map(|p| (&p.name, "a parameter")))
-        .chain(spec.inputs.iter().map(|i| (i, "an input")))
-        .chain(spec.definitions.iter().map(|d| (&d.name, "a definition")));
-    for (name, what) in symbols {
-        if let Some((_, first)) = seen.iter().find(|(n, _)| n.text == name.text) {
+    let mut seen: std::collections::HashMap<&str, &str> = std::collections::HashMap::new();
+    for (name, what) in spec.declared() {
+        if let Some(first) = seen.get(name.text.as_str()) {
             cx.error(
                 name.loc,
                 format!(
@@ -145,18 +125,16 @@ fn check_duplicates(cx: &Ctxt, spec: &ModelSpec) {
                 ),
             );
         } else {
-            seen.push((name, what));
+            seen.insert(&name.text, what);
         }
     }
-    let mut constraints: Vec<&str> = Vec::new();
+    let mut constraints: HashSet<&str> = HashSet::new();
     for c in &spec.constraints {
-        if constraints.contains(&c.name.text.as_str()) {
+        if !constraints.insert(&c.name.text) {
             cx.error(
                 c.name.loc,
                 format!("duplicate constraint `{}`", c.name.text),
             );
-        } else {
-            constraints.push(&c.name.text);
         }
     }
 }
@@ -180,8 +158,8 @@ fn expressions(spec: &ModelSpec) -> Vec<(String, &Expr)> {
     if let Some(p) = &spec.potential {
         all.push((format!("`{}`", keys::POTENTIAL), p));
     }
-    for f in &spec.forces {
-        all.push((format!("force on `{}`", f.coordinate.text), &f.expr));
+    for f in &spec.applied {
+        all.push((format!("applied force on `{}`", f.coordinate.text), &f.expr));
     }
     for c in &spec.constraints {
         all.push((format!("constraint `{}`", c.name.text), &c.h));
@@ -191,9 +169,9 @@ fn expressions(spec: &ModelSpec) -> Vec<(String, &Expr)> {
 
 // Every name in an expression is declared; a definition is used only after
 // it is defined (definitions are read in order, so none is recursive).
-fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec) {
+fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     for (i, d) in spec.definitions.iter().enumerate() {
-        d.expr.visit_names(&mut |name, loc| match spec.resolve(name) {
+        d.expr.visit(&mut |name, loc| match scope.get(name) {
             None => unknown(cx, name, loc),
             Some(Symbol::Definition(j)) if j >= i => cx.error(
                 loc,
@@ -203,8 +181,8 @@ fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec) {
         });
     }
     for (_, e) in expressions(spec).into_iter().skip(spec.definitions.len()) {
-        e.visit_names(&mut |name, loc| {
-            if spec.resolve(name).is_none() {
+        e.visit(&mut |name, loc| {
+            if scope.get(name).is_none() {
                 unknown(cx, name, loc);
             }
         });
@@ -226,45 +204,55 @@ struct Deps {
     input: bool,
 }
 
+impl Deps {
+    fn of(symbol: Option<Symbol>, defs: &[Deps]) -> Deps {
+        match symbol {
+            Some(Symbol::Var(var)) => Deps {
+                velocity: matches!(var, Var::Velocity(_)),
+                time: var == Var::Time,
+                input: matches!(var, Var::Input(_)),
+            },
+            Some(Symbol::Definition(j)) => defs.get(j).copied().unwrap_or_default(),
+            _ => Deps::default(),
+        }
+    }
+
+    fn or(self, other: Deps) -> Deps {
+        Deps {
+            velocity: self.velocity | other.velocity,
+            time: self.time | other.time,
+            input: self.input | other.input,
+        }
+    }
+}
+
+/// The culprit of a dependency: the name that brings it, where it is used,
+/// and the definition it hides behind (if any).
+type Culprit<'a> = (&'a str, Loc, Option<&'a str>);
+
 /// The first name in `e` (looking through definitions) that makes it depend
-/// on something `bad` rejects, with the definition it hides behind.
+/// on something `bad` rejects.
 fn offending<'a>(
     spec: &'a ModelSpec,
+    scope: &Scope<'_>,
     defs: &[Deps],
     e: &'a Expr,
     bad: &dyn Fn(Deps) -> bool,
-) -> Option<(&'a str, Loc, Option<&'a str>)> {
+) -> Option<Culprit<'a>> {
     let mut found = None;
-    e.visit_names(&mut |name, loc| {
+    e.visit(&mut |name: &'a String, loc| {
         if found.is_some() {
             return;
         }
-        let deps = match spec.resolve(name) {
-            Some(Symbol::Velocity(_)) => Deps {
-                velocity: true,
-                ..Deps::default()
-            },
-            Some(Symbol::Time) => Deps {
-                time: true,
-                ..Deps::default()
-            },
-            Some(Symbol::Input(_)) => Deps {
-                input: true,
-                ..Deps::default()
-            },
-            Some(Symbol::Definition(j)) if j < defs.len() => {
-                if bad(defs[j]) {
-                    // find the culprit inside the definition
-                    let inner = offending(spec, &defs[..j], &spec.definitions[j].expr, bad);
-                    let culprit = inner.map_or(name, |(n, _, _)| n);
-                    found = Some((culprit, loc, Some(name)));
-                }
-                return;
+        let symbol = scope.get(name);
+        match symbol {
+            Some(Symbol::Definition(j)) if j < defs.len() && bad(defs[j]) => {
+                let inner = offending(spec, scope, &defs[..j], &spec.definitions[j].expr, bad);
+                let culprit = inner.map_or(name.as_str(), |(n, _, _)| n);
+                found = Some((culprit, loc, Some(name.as_str())));
             }
-            _ => Deps::default(),
-        };
-        if bad(deps) {
-            found = Some((name, loc, None));
+            _ if bad(Deps::of(symbol, defs)) => found = Some((name, loc, None)),
+            _ => {}
         }
     });
     found
@@ -273,43 +261,35 @@ fn offending<'a>(
 // `V`, every `h` and `T` may not depend on time or inputs; `V` and `h` may
 // not depend on velocities (the paper's `V(q)` and `h(q)`); looked for
 // through definitions.
-fn check_dependencies(cx: &Ctxt, spec: &ModelSpec) {
-    let mut defs: Vec<Deps> = Vec::new();
+fn check_dependencies(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    let mut defs: Vec<Deps> = Vec::with_capacity(spec.definitions.len());
     for d in &spec.definitions {
         let mut deps = Deps::default();
-        d.expr.visit_names(&mut |name, _| match spec.resolve(name) {
-            Some(Symbol::Velocity(_)) => deps.velocity = true,
-            Some(Symbol::Time) => deps.time = true,
-            Some(Symbol::Input(_)) => deps.input = true,
-            Some(Symbol::Definition(j)) if j < defs.len() => {
-                deps.velocity |= defs[j].velocity;
-                deps.time |= defs[j].time;
-                deps.input |= defs[j].input;
-            }
-            _ => {}
-        });
+        d.expr
+            .visit(&mut |name, _| deps = deps.or(Deps::of(scope.get(name), &defs)));
         defs.push(deps);
     }
     let report = |what: &str, e: &Expr, allow_velocity: bool| {
         let bad = |d: Deps| d.time || d.input || (d.velocity && !allow_velocity);
-        if let Some((name, loc, through)) = offending(spec, &defs, e, &bad) {
-            let kind = match spec.resolve(name) {
-                Some(Symbol::Velocity(_)) => "the velocity",
-                Some(Symbol::Time) => "the time",
-                Some(Symbol::Input(_)) => "the input",
-                _ => "",
-            };
-            let via = through.map_or(String::new(), |d| format!(" (through definition `{d}`)"));
-            let rule = if allow_velocity {
-                "may depend only on coordinates, velocities and parameters"
-            } else {
-                "may depend only on coordinates and parameters"
-            };
-            cx.error(
-                loc,
-                format!("{what} {rule}, but it uses {kind} `{name}`{via}"),
-            );
-        }
+        let Some((name, loc, through)) = offending(spec, scope, &defs, e, &bad) else {
+            return;
+        };
+        let kind = match scope.get(name) {
+            Some(Symbol::Var(Var::Velocity(_))) => "the velocity",
+            Some(Symbol::Var(Var::Time)) => "the time",
+            Some(Symbol::Var(Var::Input(_))) => "the input",
+            _ => "",
+        };
+        let via = through.map_or(String::new(), |d| format!(" (through definition `{d}`)"));
+        let rule = if allow_velocity {
+            "may depend only on coordinates, velocities and parameters"
+        } else {
+            "may depend only on coordinates and parameters"
+        };
+        cx.error(
+            loc,
+            format!("{what} {rule}, but it uses {kind} `{name}`{via}"),
+        );
     };
     if let Some(k) = &spec.kinetic {
         report("the kinetic energy", k, true);
@@ -322,25 +302,25 @@ fn check_dependencies(cx: &Ctxt, spec: &ModelSpec) {
     }
 }
 
-// A force acts on a declared coordinate, at most once per coordinate.
-fn check_forces(cx: &Ctxt, spec: &ModelSpec) {
-    for (i, f) in spec.forces.iter().enumerate() {
-        if spec.coordinate_index(&f.coordinate.text).is_none() {
-            cx.error(
-                f.coordinate.loc,
+// An applied force acts on a declared coordinate, at most once per
+// coordinate.
+fn check_applied(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    let mut seen = HashSet::new();
+    for f in &spec.applied {
+        let name = &f.coordinate;
+        match scope.coordinate(&name.text) {
+            None => cx.error(
+                name.loc,
                 format!(
-                    "`{}` is not a coordinate; forces are given per coordinate",
-                    f.coordinate.text
+                    "`{}` is not a coordinate; applied forces are given per coordinate",
+                    name.text
                 ),
-            );
-        } else if spec.forces[..i]
-            .iter()
-            .any(|g| g.coordinate.text == f.coordinate.text)
-        {
-            cx.error(
-                f.coordinate.loc,
-                format!("duplicate force on `{}`", f.coordinate.text),
-            );
+            ),
+            Some(i) if !seen.insert(i) => cx.error(
+                name.loc,
+                format!("duplicate applied force on `{}`", name.text),
+            ),
+            Some(_) => {}
         }
     }
 }
@@ -370,11 +350,12 @@ fn check_restitution(cx: &Ctxt, spec: &ModelSpec) {
 }
 
 // Initial values name a coordinate or a velocity, once each.
-fn check_initial(cx: &Ctxt, spec: &ModelSpec) {
-    for (i, (name, _)) in spec.initial.iter().enumerate() {
-        match spec.resolve(&name.text) {
-            Some(Symbol::Coordinate(_) | Symbol::Velocity(_)) => {
-                if spec.initial[..i].iter().any(|(n, _)| n.text == name.text) {
+fn check_initial(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    let mut seen = HashSet::new();
+    for (name, _) in &spec.initial {
+        match scope.get(&name.text) {
+            Some(Symbol::Var(Var::Coordinate(_) | Var::Velocity(_))) => {
+                if !seen.insert(name.text.as_str()) {
                     cx.error(
                         name.loc,
                         format!("duplicate initial value for `{}`", name.text),

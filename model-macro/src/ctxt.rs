@@ -4,53 +4,21 @@
 
 use std::cell::RefCell;
 
-use proc_macro2::Span;
+use crate::loc::{Loc, YamlPos};
 
-use crate::front::yaml_tree::YamlSource;
-
-/// Where something in a model came from.
-///
-/// Inline models carry the token's span. YAML models carry the span of the
-/// `file = "..."` literal plus the YAML node and the byte offset inside its
-/// scalar; the node's line and column are recovered only when an error is
-/// reported (see [`YamlSource::locate`]).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Loc {
-    pub span: Span,
-    pub node: Option<YamlPos>,
-}
-
-/// A position inside a YAML document: the node's index in document order and
-/// a byte offset into its scalar text.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct YamlPos {
-    pub node: usize,
-    pub offset: usize,
-}
-
-impl Loc {
-    /// A location inside inline tokens.
-    pub fn span(span: Span) -> Self {
-        Loc { span, node: None }
-    }
-
-    /// The same location moved `offset` bytes further into its scalar (for
-    /// tokens of a YAML expression). Inline locations are unchanged.
-    pub fn shifted(self, offset: usize) -> Self {
-        Loc {
-            span: self.span,
-            node: self.node.map(|p| YamlPos {
-                node: p.node,
-                offset: p.offset + offset,
-            }),
-        }
-    }
+/// Turns a YAML position into `path:line:column`; the YAML front end hands
+/// one to the context as a value, so that this module knows nothing of YAML.
+pub(crate) trait Locate {
+    /// `path:line:column` of `pos`.
+    fn describe(&self, pos: YamlPos) -> String;
+    /// The file's path as shown to the user.
+    fn display(&self) -> &str;
 }
 
 /// The error collector shared, by reference, by every stage.
 pub(crate) struct Ctxt {
     errors: RefCell<Option<Vec<(Loc, String)>>>,
-    yaml: Option<YamlSource>,
+    locator: Option<Box<dyn Locate>>,
 }
 
 impl Ctxt {
@@ -58,16 +26,16 @@ impl Ctxt {
     pub fn new() -> Self {
         Ctxt {
             errors: RefCell::new(Some(Vec::new())),
-            yaml: None,
+            locator: None,
         }
     }
 
-    /// A collector for a model read from YAML: errors are prefixed with
-    /// `path:line:column`.
-    pub fn with_yaml(source: YamlSource) -> Self {
+    /// A collector for a model read from a file: errors are prefixed with
+    /// `path:line:column` by `locator`.
+    pub fn with_locator(locator: impl Locate + 'static) -> Self {
         Ctxt {
             errors: RefCell::new(Some(Vec::new())),
-            yaml: Some(source),
+            locator: Some(Box::new(locator)),
         }
     }
 
@@ -91,9 +59,9 @@ impl Ctxt {
         let errors = self.errors.borrow_mut().take().unwrap_or_default();
         let mut combined: Option<syn::Error> = None;
         for (loc, message) in errors {
-            let text = match (&self.yaml, loc.node) {
-                (Some(yaml), Some(pos)) => format!("{}: {message}", yaml.describe(pos)),
-                (Some(yaml), None) => format!("{}: {message}", yaml.display),
+            let text = match (&self.locator, loc.node) {
+                (Some(file), Some(pos)) => format!("{}: {message}", file.describe(pos)),
+                (Some(file), None) => format!("{}: {message}", file.display()),
                 _ => message,
             };
             let error = syn::Error::new(loc.span, text);

@@ -7,8 +7,10 @@ use proc_macro2::{TokenStream, TokenTree};
 
 use crate::ctxt::Ctxt;
 use crate::front::{inline, yaml};
+use crate::lower::Lowered;
+use crate::resolve::{Resolved, Scope};
 use crate::spec::ModelSpec;
-use crate::{check, emit, lower};
+use crate::{check, emit, lower, resolve};
 
 /// Expands one `model!` invocation.
 ///
@@ -40,7 +42,7 @@ fn try_expand(input: TokenStream) -> syn::Result<TokenStream> {
         let (source, path) = yaml::read(&args)?;
         let root = yaml::parse_tree(&source, span)?;
         let text = source.text.clone();
-        let cx = Ctxt::with_yaml(source);
+        let cx = Ctxt::with_locator(source);
         let spec = yaml::build(&cx, &root, span, &path, text);
         finish(cx, spec)
     } else {
@@ -59,20 +61,37 @@ fn is_file_form(input: &TokenStream) -> bool {
     )
 }
 
+/// The stages after the front end: checks, resolution into typed symbols,
+/// lowering. `None` when any of them recorded an error (or, for
+/// resolution, met a name the checks should have reported: the caller
+/// reports that as an internal error).
+pub(crate) fn compile<'a>(cx: &Ctxt, spec: &'a ModelSpec) -> Option<(Resolved<'a>, Lowered)> {
+    let scope = Scope::new(spec);
+    check::check(cx, spec, &scope);
+    if cx.has_errors() {
+        return None;
+    }
+    let model = resolve::resolve(spec, &scope)?;
+    let lowered = lower::lower(cx, &model)?;
+    Some((model, lowered))
+}
+
 fn finish(cx: Ctxt, spec: Option<ModelSpec>) -> syn::Result<TokenStream> {
+    let internal = || {
+        syn::Error::new(
+            proc_macro2::Span::call_site(),
+            "moreau::model!: a stage failed without saying why (a bug in the macro; please report it)",
+        )
+    };
     let Some(spec) = spec else {
+        // The front ends give up only after recording why.
         cx.check()?;
-        unreachable!("a front end gave up without recording an error");
+        return Err(internal());
     };
-    check::check(&cx, &spec);
-    let lowered = if cx.has_errors() {
-        None
-    } else {
-        lower::lower(&cx, &spec)
-    };
-    match (cx.check(), lowered) {
-        (Ok(()), Some(model)) => Ok(emit::emit(&spec, &model)),
-        (Ok(()), None) => unreachable!("lowering failed without recording an error"),
+    let compiled = compile(&cx, &spec);
+    match (cx.check(), compiled) {
+        (Ok(()), Some((model, lowered))) => Ok(emit::emit(&model, &lowered)),
+        (Ok(()), None) => Err(internal()),
         (Err(errors), _) => {
             let mut out = errors.into_compile_error();
             out.extend(emit::fallback(&spec));

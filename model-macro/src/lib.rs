@@ -24,8 +24,11 @@ mod emit;
 mod expand;
 mod expr;
 mod front;
+mod keys;
+mod loc;
 mod lower;
 mod render;
+mod resolve;
 mod spec;
 
 use proc_macro::TokenStream;
@@ -37,3 +40,5 @@ use proc_macro::TokenStream;
 pub fn model(input: TokenStream) -> TokenStream {
     expand::model(input.into()).into()
 }
+#[cfg(test)]
+mod tests;

@@ -1,105 +1,67 @@
-//! Lowering: a checked [`ModelSpec`] becomes a symbolic graph, and the
-//! mechanics (M, C, G, F, h, J) are derived on it with `moreau-sym`.
+//! Lowering: a [`Resolved`] model becomes a symbolic graph, and the
+//! mechanics (every quantity of `moreau_sym::Quantity`) are derived on it
+//! with `moreau-sym`.
 //!
-//! Variables are numbered in one fixed layout ([`Layout`]): coordinates,
-//! velocities, time, inputs, parameters. Definitions are not variables: each
-//! is built once and its node reused wherever its name appears.
+//! Variables are numbered by the model's [`VarLayout`]. Definitions are not
+//! variables: each is built once and its node reused wherever it is named.
 
-use moreau_sym::{Graph, Id, Lagrangian, Mechanics, MechanicsError, VarId};
+use moreau_sym::{
+    Graph, Id, Lagrangian, Mechanics, MechanicsError, Node, Operand, Schedule, VarId,
+};
 
-use crate::ctxt::{Ctxt, Loc};
-use crate::expr::{BinOp, Expr, ExprKind, Func};
-use crate::spec::{ModelSpec, Symbol};
-
-/// The numbering of the model's variables in the graph.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Layout {
-    pub n: usize,
-    pub inputs: usize,
-}
-
-/// What a graph variable stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Var {
-    Coordinate(usize),
-    Velocity(usize),
-    Time,
-    Input(usize),
-    Parameter(usize),
-}
-
-impl Layout {
-    fn of(spec: &ModelSpec) -> Layout {
-        Layout {
-            n: spec.dofs(),
-            inputs: spec.inputs.len(),
-        }
-    }
-
-    /// The graph variable of `var`.
-    pub fn id(&self, var: Var) -> VarId {
-        let n = self.n;
-        let index = match var {
-            Var::Coordinate(i) => i,
-            Var::Velocity(i) => n + i,
-            Var::Time => 2 * n,
-            Var::Input(i) => 2 * n + 1 + i,
-            Var::Parameter(i) => 2 * n + 1 + self.inputs + i,
-        };
-        VarId(index as u32)
-    }
-
-    /// What graph variable `id` stands for.
-    pub fn var(&self, id: VarId) -> Var {
-        let (n, i) = (self.n, id.index());
-        if i < n {
-            Var::Coordinate(i)
-        } else if i < 2 * n {
-            Var::Velocity(i - n)
-        } else if i == 2 * n {
-            Var::Time
-        } else if i < 2 * n + 1 + self.inputs {
-            Var::Input(i - 2 * n - 1)
-        } else {
-            Var::Parameter(i - 2 * n - 1 - self.inputs)
-        }
-    }
-}
+use crate::ctxt::Ctxt;
+use crate::expr::{BinOp, Expr, ExprKind};
+use crate::loc::Loc;
+use crate::resolve::{Resolved, Symbol, Var, VarLayout};
 
 /// The lowered model: its graph, variable layout and derived mechanics.
 pub(crate) struct Lowered {
     pub graph: Graph,
-    pub layout: Layout,
     pub mechanics: Mechanics,
 }
 
 /// Builds the graph and derives the mechanics. Records an error and returns
-/// `None` when the kinetic energy is not a quadratic form in the velocities.
-pub(crate) fn lower(cx: &Ctxt, spec: &ModelSpec) -> Option<Lowered> {
-    let layout = Layout::of(spec);
+/// `None` when an expression folds to a non-finite constant or the kinetic
+/// energy is not a quadratic form in the velocities.
+pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
+    let layout = model.layout;
     let mut b = Builder {
-        spec,
+        cx,
         layout,
         graph: Graph::new(),
-        definitions: Vec::new(),
+        definitions: Vec::with_capacity(model.definitions.len()),
     };
-    for d in &spec.definitions {
-        let id = b.expr(&d.expr);
+    for d in &model.definitions {
+        let id = b.expr(d)?;
         b.definitions.push(id);
     }
-    let kinetic_expr = spec.kinetic.as_ref()?;
-    let kinetic = b.expr(kinetic_expr);
-    let potential = match &spec.potential {
-        Some(p) => b.expr(p),
+    let kinetic = b.expr(&model.kinetic)?;
+    let potential = match &model.potential {
+        Some(p) => b.expr(p)?,
         None => b.graph.constant(0.0),
     };
-    let forces: Vec<Id> = (0..layout.n)
-        .map(|i| match spec.force_on(i) {
-            Some(f) => b.expr(f),
+    let mut applied = Vec::with_capacity(layout.n);
+    for a in &model.applied {
+        applied.push(match a {
+            Some(e) => b.expr(e)?,
             None => b.graph.constant(0.0),
-        })
-        .collect();
-    let gaps: Vec<Id> = spec.constraints.iter().map(|c| b.expr(&c.h)).collect();
+        });
+    }
+    let mut gaps = Vec::with_capacity(model.k());
+    for (h, c) in model.gaps.iter().zip(&model.spec.constraints) {
+        let id = b.expr(h)?;
+        // A gap that does not move with the configuration constrains nothing
+        // (`0 >= 1` is always violated or always satisfied).
+        let moves = (0..layout.n).any(|i| b.graph.depends_on(id, layout.id(Var::Coordinate(i))));
+        if !moves {
+            cx.error(
+                h.loc,
+                format!("constraint `{}` does not depend on any coordinate: it can never be reached or left", c.name.text),
+            );
+            return None;
+        }
+        gaps.push(id);
+    }
     let q: Vec<VarId> = (0..layout.n)
         .map(|i| layout.id(Var::Coordinate(i)))
         .collect();
@@ -110,47 +72,116 @@ pub(crate) fn lower(cx: &Ctxt, spec: &ModelSpec) -> Option<Lowered> {
         v: &v,
         kinetic,
         potential,
-        forces: &forces,
+        applied: &applied,
         gaps: &gaps,
     };
-    let mechanics = match Mechanics::derive(&mut graph, &system) {
-        Ok(m) => m,
-        Err(e) => {
-            let names: Vec<&str> = spec.coordinates.iter().map(|c| c.v.text.as_str()).collect();
-            let culprit = match e {
-                MechanicsError::NotQuadratic { velocity, .. }
-                | MechanicsError::LinearTerm { velocity } => Some(velocity),
-                _ => None,
-            };
-            let loc = culprit
-                .and_then(|k| first_use(spec, kinetic_expr, names[k]))
-                .unwrap_or(kinetic_expr.loc);
-            cx.error(loc, e.describe(&names));
-            return None;
+    match Mechanics::derive(&mut graph, &system) {
+        Ok(mechanics) => {
+            check_mass_diagonal(cx, model, &graph, &mechanics)?;
+            check_finite_constants(cx, model, &graph, &mechanics)?;
+            Some(Lowered { graph, mechanics })
         }
-    };
-    Some(Lowered {
-        graph,
-        layout,
-        mechanics,
-    })
+        Err(e) => {
+            report(cx, model, &e);
+            None
+        }
+    }
 }
 
-/// Where `e` first uses the variable `name`, directly or through a
-/// definition (then the definition's use is given).
-fn first_use(spec: &ModelSpec, e: &Expr, name: &str) -> Option<Loc> {
+/// No derived quantity may hold a non-finite constant (the expressions are
+/// checked as they are built; this is the net under differentiation).
+fn check_finite_constants(
+    cx: &Ctxt,
+    model: &Resolved<'_>,
+    graph: &Graph,
+    mechanics: &Mechanics,
+) -> Option<()> {
+    let sched = Schedule::new(graph, &mechanics.outputs());
+    let operands = sched
+        .instrs
+        .iter()
+        .flat_map(|i| i.operands().iter().copied())
+        .chain(sched.outputs.iter().copied());
+    for operand in operands {
+        if let Operand::Const(c) = operand
+            && !c.is_finite()
+        {
+            cx.error(
+                model.kinetic.loc,
+                format!("a derived quantity of this model holds the constant {c}, which is not a finite number"),
+            );
+            return None;
+        }
+    }
+    Some(())
+}
+
+/// `M` must be positive definite; what can be decided from its structure is
+/// decided here: a diagonal entry that is a constant `≤ 0` (a velocity absent
+/// from `T`, `T = −½ vy²`, `T = vx vy`, `T = 0`) makes it singular or
+/// indefinite everywhere. Reported at the kinetic energy, naming the
+/// velocity.
+fn check_mass_diagonal(
+    cx: &Ctxt,
+    model: &Resolved<'_>,
+    graph: &Graph,
+    mechanics: &Mechanics,
+) -> Option<()> {
+    let mut ok = true;
+    for i in 0..model.n() {
+        let Some(m) = graph.as_const(mechanics.mass[i][i]) else {
+            continue;
+        };
+        if m <= 0.0 {
+            let v = model.var_name(Var::Velocity(i));
+            let why = if m == 0.0 {
+                format!("the kinetic energy has no term in `{v}`^2 (M[{i},{i}] = ∂²T/∂{v}² = 0)")
+            } else {
+                format!("M[{i},{i}] = ∂²T/∂{v}² = {m} is negative")
+            };
+            let loc =
+                first_use(model, &model.kinetic, Var::Velocity(i)).unwrap_or(model.kinetic.loc);
+            cx.error(
+                loc,
+                format!("{why}: the mass matrix is not positive definite"),
+            );
+            ok = false;
+        }
+    }
+    ok.then_some(())
+}
+
+/// Reports a mechanics error at the first use of the velocity it names.
+fn report(cx: &Ctxt, model: &Resolved<'_>, e: &MechanicsError) {
+    let names: Vec<&str> = (0..model.n())
+        .map(|i| model.var_name(Var::Velocity(i)))
+        .collect();
+    let culprit = match *e {
+        MechanicsError::NotQuadratic { velocity, .. } | MechanicsError::LinearTerm { velocity } => {
+            Some(velocity)
+        }
+        _ => None,
+    };
+    let loc = culprit
+        .and_then(|k| first_use(model, &model.kinetic, Var::Velocity(k)))
+        .unwrap_or(model.kinetic.loc);
+    cx.error(loc, e.describe(&names));
+}
+
+/// Where `e` first uses `var`, directly or through a definition (then the
+/// definition's use is given).
+fn first_use(model: &Resolved<'_>, e: &Expr<Symbol>, var: Var) -> Option<Loc> {
     let mut found = None;
-    e.visit_names(&mut |used, loc| {
+    e.visit(&mut |symbol, loc| {
         if found.is_some() {
             return;
         }
-        let through_definition = match spec.resolve(used) {
-            Some(Symbol::Definition(i)) => {
-                first_use(spec, &spec.definitions[i].expr, name).is_some()
-            }
-            _ => false,
+        let hit = match *symbol {
+            Symbol::Var(v) => v == var,
+            Symbol::Definition(i) => first_use(model, &model.definitions[i], var).is_some(),
+            Symbol::Pi => false,
         };
-        if used == name || through_definition {
+        if hit {
             found = Some(loc);
         }
     });
@@ -158,83 +189,68 @@ fn first_use(spec: &ModelSpec, e: &Expr, name: &str) -> Option<Loc> {
 }
 
 struct Builder<'a> {
-    spec: &'a ModelSpec,
-    layout: Layout,
+    cx: &'a Ctxt,
+    layout: VarLayout,
     graph: Graph,
     definitions: Vec<Id>,
 }
 
 impl Builder<'_> {
-    fn expr(&mut self, e: &Expr) -> Id {
-        match &e.kind {
-            ExprKind::Num(x) => self.graph.constant(*x),
-            ExprKind::Name(name) => self.name(name),
+    /// The node of `e`; `None` after reporting a subexpression that folds
+    /// to a non-finite constant (`1/0`, `ln(0)`, `2^1024`).
+    fn expr(&mut self, e: &Expr<Symbol>) -> Option<Id> {
+        let before = self.graph.len();
+        let g = &mut self.graph;
+        let id = match &e.kind {
+            ExprKind::Num(x) => g.constant(*x),
+            ExprKind::Name(Symbol::Var(var)) => g.var(self.layout.id(*var)),
+            ExprKind::Name(Symbol::Definition(i)) => self.definitions[*i],
+            ExprKind::Name(Symbol::Pi) => g.constant(std::f64::consts::PI),
             ExprKind::Neg(a) => {
-                let a = self.expr(a);
+                let a = self.expr(a)?;
                 self.graph.neg(a)
             }
+            ExprKind::Func(f, a) => {
+                let a = self.expr(a)?;
+                self.graph.func(*f, a)
+            }
+            ExprKind::Atan2(y, x) => {
+                let (y, x) = (self.expr(y)?, self.expr(x)?);
+                self.graph.atan2(y, x)
+            }
             ExprKind::Binary(op, a, b) => {
-                let (a, b) = (self.expr(a), self.expr(b));
+                let (a, b) = (self.expr(a)?, self.expr(b)?);
+                if *op == BinOp::Div && self.graph.as_const(b) == Some(0.0) {
+                    self.cx.error(e.loc, "division by zero");
+                    return None;
+                }
+                let g = &mut self.graph;
                 match op {
-                    BinOp::Add => self.graph.add(a, b),
-                    BinOp::Sub => self.graph.sub(a, b),
-                    BinOp::Mul => self.graph.mul(a, b),
-                    BinOp::Div => self.graph.div(a, b),
-                    BinOp::Pow => self.graph.pow(a, b),
+                    BinOp::Add => g.add(a, b),
+                    BinOp::Sub => g.sub(a, b),
+                    BinOp::Mul => g.mul(a, b),
+                    BinOp::Div => g.div(a, b),
+                    BinOp::Pow => g.pow(a, b),
                 }
             }
-            ExprKind::Call(func, args) => {
-                let args: Vec<Id> = args.iter().map(|a| self.expr(a)).collect();
-                match func {
-                    Func::Atan2 => self.graph.atan2(args[0], args[1]),
-                    Func::Sqrt => self.graph.sqrt(args[0]),
-                    Func::Exp => self.graph.exp(args[0]),
-                    Func::Ln => self.graph.ln(args[0]),
-                    Func::Sin => self.graph.sin(args[0]),
-                    Func::Cos => self.graph.cos(args[0]),
-                    Func::Tan => self.graph.tan(args[0]),
-                    Func::Sinh => self.graph.sinh(args[0]),
-                    Func::Cosh => self.graph.cosh(args[0]),
-                    Func::Tanh => self.graph.tanh(args[0]),
-                }
-            }
-        }
-    }
-
-    fn name(&mut self, name: &str) -> Id {
-        let var = match self.spec.resolve(name) {
-            Some(Symbol::Coordinate(i)) => Var::Coordinate(i),
-            Some(Symbol::Velocity(i)) => Var::Velocity(i),
-            Some(Symbol::Parameter(i)) => Var::Parameter(i),
-            Some(Symbol::Input(i)) => Var::Input(i),
-            Some(Symbol::Time) => Var::Time,
-            Some(Symbol::Pi) => return self.graph.constant(std::f64::consts::PI),
-            Some(Symbol::Definition(i)) => return self.definitions[i],
-            None => unreachable!("unknown names are rejected by the checks"),
         };
-        let id = self.layout.id(var);
-        self.graph.var(id)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn layout_round_trips_every_variable() {
-        let layout = Layout { n: 3, inputs: 2 };
-        let mut all = Vec::new();
-        for i in 0..3 {
-            all.push(Var::Coordinate(i));
-            all.push(Var::Velocity(i));
-        }
-        all.push(Var::Time);
-        all.extend((0..2).map(Var::Input));
-        all.extend((0..4).map(Var::Parameter));
-        for (index, var) in all.into_iter().enumerate() {
-            assert_eq!(layout.var(layout.id(var)), var);
-            assert!(layout.id(var).index() < 2 * 3 + 1 + 2 + 4, "{index}");
+        // A new non-finite constant: the whole value (`ln(0)`), or a part
+        // the simplifier made (`x / 0` becomes `inf * x`).
+        let bad = self.graph.nodes()[before..].iter().find_map(|n| match *n {
+            Node::Const(bits) if !f64::from_bits(bits).is_finite() => Some(f64::from_bits(bits)),
+            _ => None,
+        });
+        match bad {
+            Some(c) => {
+                self.cx.error(
+                    e.loc,
+                    format!(
+                        "this expression folds to the constant {c}, which is not a finite number"
+                    ),
+                );
+                None
+            }
+            None => Some(id),
         }
     }
 }

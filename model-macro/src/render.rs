@@ -6,7 +6,7 @@
 use std::fmt::Write;
 
 use crate::expr::fmt_number;
-use crate::front::keys;
+use crate::keys;
 use crate::spec::{ModelSpec, Origin};
 
 /// The model's text in the YAML language.
@@ -56,9 +56,9 @@ fn canonical(spec: &ModelSpec) -> String {
     if let Some(p) = &spec.potential {
         let _ = writeln!(s, "{}: \"{p}\"", keys::POTENTIAL);
     }
-    if !spec.forces.is_empty() {
-        let _ = writeln!(s, "{}:", keys::FORCES);
-        for f in &spec.forces {
+    if !spec.applied.is_empty() {
+        let _ = writeln!(s, "{}:", keys::APPLIED);
+        for f in &spec.applied {
             let _ = writeln!(s, "  {}: \"{}\"", f.coordinate.text, f.expr);
         }
     }
@@ -102,7 +102,7 @@ mod tests {
             let r2 = x^2 + y^2;
             kinetic = 0.5 * m * (vx^2 + vy^2);
             potential = m * g * y;
-            forces { x: u - 0.1 * vx }
+            applied { x: u - 0.1 * vx }
             constraints { #[restitution = 0.5] bowl: y >= r2 - 1, lid: y <= 2 }
             restitution = 0.9;
             initial { x: 0.5, vy: -1e-3 }
@@ -119,7 +119,7 @@ mod tests {
             text: text.clone(),
         };
         let root = source.parse().unwrap();
-        let cx = Ctxt::with_yaml(source);
+        let cx = Ctxt::with_locator(source);
         let again = yaml::build(
             &cx,
             &root,

@@ -7,8 +7,8 @@
 
 use proc_macro2::TokenStream;
 
-use crate::ctxt::Loc;
 use crate::expr::Expr;
+use crate::loc::Loc;
 
 /// A name with its location.
 #[derive(Clone, Debug)]
@@ -48,7 +48,7 @@ pub(crate) struct Definition {
 
 /// An extra generalized force `Q_i`, acting on one coordinate.
 #[derive(Clone, Debug)]
-pub(crate) struct Force {
+pub(crate) struct Applied {
     pub coordinate: Name,
     pub expr: Expr,
 }
@@ -85,27 +85,53 @@ pub(crate) struct ModelSpec {
     pub definitions: Vec<Definition>,
     pub kinetic: Option<Expr>,
     pub potential: Option<Expr>,
-    pub forces: Vec<Force>,
+    pub applied: Vec<Applied>,
     pub constraints: Vec<Constraint>,
     pub restitution: Option<Number>,
     pub initial: Vec<(Name, Number)>,
     pub origin: Origin,
 }
 
-/// What a name in an expression stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Symbol {
-    Coordinate(usize),
-    Velocity(usize),
-    Parameter(usize),
-    Input(usize),
-    Definition(usize),
-    Time,
-    Pi,
-}
-
 /// Names the language reserves: the time and the constant π.
 pub(crate) const RESERVED: [&str; 2] = ["t", "pi"];
+
+/// Rust's keywords, strict and reserved: none can name anything in a model.
+pub(crate) const RUST_KEYWORDS: [&str; 52] = [
+    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for",
+    "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return",
+    "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe", "use", "where",
+    "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
+];
+
+/// Names of the prelude that a `let` binding or a field cannot take without
+/// changing meaning (`let None = …` is a pattern, not a binding).
+pub(crate) const PRELUDE_VALUES: [&str; 4] = ["None", "Some", "Ok", "Err"];
+
+/// Whether `text` is an identifier of the language: ASCII letters, digits
+/// and `_`, not starting with a digit, not `_` alone.
+///
+/// Non-ASCII names are not accepted: rustc compares identifiers after NFC
+/// normalization (`Å`, U+212B, and `Å`, U+00C5, are one identifier to it),
+/// which the macro could not reproduce without Unicode tables, so two names
+/// it thinks distinct could be one binding in the generated code.
+pub(crate) fn is_identifier(text: &str) -> bool {
+    let mut chars = text.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && text != "_"
+}
+
+/// Whether `text` can name a field of the generated type: an identifier,
+/// not a keyword, not reserved, not a prelude value, not `restitution`.
+pub(crate) fn is_field_name(text: &str) -> bool {
+    is_identifier(text)
+        && !RUST_KEYWORDS.contains(&text)
+        && !RESERVED.contains(&text)
+        && !PRELUDE_VALUES.contains(&text)
+        && text != crate::keys::RESTITUTION
+        && !text.starts_with("__")
+}
 
 impl ModelSpec {
     /// Number of degrees of freedom `N`.
@@ -118,59 +144,21 @@ impl ModelSpec {
         self.constraints.len()
     }
 
-    /// What `name` stands for, if anything. Definitions are found whatever
-    /// their position; whether one is used before it is defined is a check.
-    pub fn resolve(&self, name: &str) -> Option<Symbol> {
-        if name == "t" {
-            return Some(Symbol::Time);
-        }
-        if name == "pi" {
-            return Some(Symbol::Pi);
-        }
-        fn find<'a>(mut names: impl Iterator<Item = &'a Name>, name: &str) -> Option<usize> {
-            names.position(|n| n.text == name)
-        }
-        if let Some(i) = find(self.coordinates.iter().map(|c| &c.q), name) {
-            return Some(Symbol::Coordinate(i));
-        }
-        if let Some(i) = find(self.coordinates.iter().map(|c| &c.v), name) {
-            return Some(Symbol::Velocity(i));
-        }
-        if let Some(i) = find(self.parameters.iter().map(|p| &p.name), name) {
-            return Some(Symbol::Parameter(i));
-        }
-        if let Some(i) = find(self.inputs.iter(), name) {
-            return Some(Symbol::Input(i));
-        }
-        find(self.definitions.iter().map(|d| &d.name), name).map(Symbol::Definition)
-    }
-
-    /// Index of the coordinate called `name`.
-    pub fn coordinate_index(&self, name: &str) -> Option<usize> {
-        self.coordinates.iter().position(|c| c.q.text == name)
-    }
-
     /// The restitution coefficient of constraint `i`: its own, else the
     /// model's, else none (a check reports that).
     pub fn restitution_of(&self, i: usize) -> Option<Number> {
         self.constraints[i].restitution.or(self.restitution)
     }
 
-    /// The initial value of the coordinate or velocity called `name` (0 when
-    /// the model gives none).
-    pub fn initial_value(&self, name: &str) -> f64 {
-        self.initial
+    /// Every name the model declares in the one namespace of expressions
+    /// (coordinates, velocities, parameters, inputs, definitions), with
+    /// what it is, in declaration order.
+    pub fn declared(&self) -> impl Iterator<Item = (&Name, &'static str)> {
+        self.coordinates
             .iter()
-            .find(|(n, _)| n.text == name)
-            .map_or(0.0, |(_, x)| x.value)
-    }
-
-    /// The force expression on coordinate `i`, if the model gives one.
-    pub fn force_on(&self, i: usize) -> Option<&Expr> {
-        let name = &self.coordinates[i].q.text;
-        self.forces
-            .iter()
-            .find(|f| &f.coordinate.text == name)
-            .map(|f| &f.expr)
+            .flat_map(|c| [(&c.q, "a coordinate"), (&c.v, "a velocity")])
+            .chain(self.parameters.iter().map(|p| (&p.name, "a parameter")))
+            .chain(self.inputs.iter().map(|i| (i, "an input")))
+            .chain(self.definitions.iter().map(|d| (&d.name, "a definition")))
     }
 }

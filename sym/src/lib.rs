@@ -33,7 +33,7 @@
 //! let c = gr.cos(the);
 //! let v = gr.mul(mgl, c);
 //! let v = gr.neg(v);
-//! let sys = Lagrangian { q: &[th], v: &[w], kinetic: t, potential: v, forces: &[], gaps: &[] };
+//! let sys = Lagrangian { q: &[th], v: &[w], kinetic: t, potential: v, applied: &[], gaps: &[] };
 //! let mech = Mechanics::derive(&mut gr, &sys).unwrap();
 //!
 //! let fused = Schedule::new(&gr, &mech.outputs());
@@ -61,5 +61,5 @@ mod testing;
 
 pub use graph::Graph;
 pub use mechanics::{Lagrangian, Layout, Mechanics, MechanicsError, Quantity, Slot};
-pub use node::{Func, Id, Node, Op, VarId};
+pub use node::{Func, Function, Id, Node, Op, VarId};
 pub use schedule::{Instr, Operand, Schedule};

@@ -182,6 +182,72 @@ impl fmt::Display for Func {
     }
 }
 
+/// A function of the model language: an elementary [`Func`] of one
+/// argument, or `atan2(y, x)`. This is the one list of the language's
+/// functions; the macro's parser, its messages and its emitter read it.
+///
+/// ```
+/// use moreau_sym::{Func, Function};
+/// assert_eq!(Function::from_name("atan2"), Some(Function::Atan2));
+/// assert_eq!(Function::from_name("cos"), Some(Function::Unary(Func::Cos)));
+/// assert_eq!(Function::Atan2.arity(), 2);
+/// assert_eq!(Function::ALL.len(), 10);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Function {
+    /// An elementary function of one argument.
+    Unary(Func),
+    /// `atan2(y, x)`, [`f64::atan2`].
+    Atan2,
+}
+
+impl Function {
+    /// Every function of the language, in the order messages list them.
+    pub const ALL: [Function; 10] = [
+        Function::Unary(Func::Sqrt),
+        Function::Unary(Func::Exp),
+        Function::Unary(Func::Ln),
+        Function::Unary(Func::Sin),
+        Function::Unary(Func::Cos),
+        Function::Unary(Func::Tan),
+        Function::Atan2,
+        Function::Unary(Func::Sinh),
+        Function::Unary(Func::Cosh),
+        Function::Unary(Func::Tanh),
+    ];
+
+    /// The function's name in the model language (and of the `f64` method
+    /// that evaluates it).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Function::Unary(f) => f.name(),
+            Function::Atan2 => "atan2",
+        }
+    }
+
+    /// Number of arguments.
+    #[must_use]
+    pub fn arity(self) -> usize {
+        match self {
+            Function::Unary(_) => 1,
+            Function::Atan2 => 2,
+        }
+    }
+
+    /// The function called `name` in the model language, if any.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Function> {
+        Function::ALL.into_iter().find(|f| f.name() == name)
+    }
+}
+
+impl fmt::Display for Function {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One node of the expression graph.
 ///
 /// Subtraction is a node of its own (rather than `a + (-b)`) so that

@@ -201,8 +201,8 @@ pub(crate) struct Spec {
     pub defs: &'static [(&'static str, &'static str)],
     pub kinetic: &'static str,
     pub potential: &'static str,
-    /// Generalized forces by coordinate name (missing = 0).
-    pub forces: &'static [(&'static str, &'static str)],
+    /// Applied generalized forces by coordinate name (missing = 0).
+    pub applied: &'static [(&'static str, &'static str)],
     pub gaps: &'static [&'static str],
 }
 
@@ -215,7 +215,7 @@ pub(crate) struct Built {
     pub v: Vec<VarId>,
     pub kinetic: Id,
     pub potential: Id,
-    pub forces: Vec<Id>,
+    pub applied: Vec<Id>,
     pub gaps: Vec<Id>,
 }
 
@@ -229,7 +229,7 @@ impl Built {
             v: &self.v,
             kinetic: self.kinetic,
             potential: self.potential,
-            forces: &self.forces,
+            applied: &self.applied,
             gaps: &self.gaps,
         };
         crate::mechanics::Mechanics::derive(&mut self.g, &sys)
@@ -256,10 +256,10 @@ impl Spec {
         }
         let kinetic = parse(&mut g, &names, &defs, self.kinetic);
         let potential = parse(&mut g, &names, &defs, self.potential);
-        let forces = self
+        let applied = self
             .coords
             .iter()
-            .map(|(c, _)| match self.forces.iter().find(|f| f.0 == *c) {
+            .map(|(c, _)| match self.applied.iter().find(|f| f.0 == *c) {
                 Some((_, src)) => parse(&mut g, &names, &defs, src),
                 None => g.constant(0.0),
             })
@@ -276,7 +276,7 @@ impl Spec {
             v,
             kinetic,
             potential,
-            forces,
+            applied,
             gaps,
         }
     }
@@ -293,7 +293,7 @@ pub(crate) const DOUBLE_PENDULUM: Spec = Spec {
     kinetic: "0.5 * (m1 + m2) * l1^2 * w1^2 + 0.5 * m2 * l2^2 * w2^2
         + m2 * l1 * l2 * w1 * w2 * cos(th1 - th2)",
     potential: "-(m1 + m2) * g * l1 * cos(th1) - m2 * g * l2 * cos(th2)",
-    forces: &[
+    applied: &[
         ("th1", "-b * w1 + b * (w2 - w1)"),
         ("th2", "-b * (w2 - w1)"),
     ],
@@ -333,7 +333,7 @@ pub(crate) const ARM3: Spec = Spec {
     kinetic: "0.5 * m1 * (vx1^2 + vy1^2) + 0.5 * m2 * (vx2^2 + vy2^2) + 0.5 * m3 * (vx3^2 + vy3^2)
         + (m1 * l1^2 * w1^2 + m2 * l2^2 * w2^2 + m3 * l3^2 * w3^2) / 24",
     potential: "g * (m1 * y1 + m2 * y2 + m3 * y3)",
-    forces: &[
+    applied: &[
         ("q1", "u1 - b * dq1"),
         ("q2", "u2 - b * dq2"),
         ("q3", "u3 - b * dq3"),
@@ -348,6 +348,6 @@ pub(crate) const PARABOLA: Spec = Spec {
     defs: &[],
     kinetic: "0.5 * m * (vx^2 + vy^2)",
     potential: "m * g * y",
-    forces: &[],
+    applied: &[],
     gaps: &["y - x^2", "c - y"],
 };

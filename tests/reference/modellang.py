@@ -7,21 +7,17 @@ grammar), written for the CasADi reference tool
 ends, on purpose: the point is to check them.
 
 Expressions are parsed by a hand-written recursive-descent parser (no
-``eval``) following the README's grammar::
-
-    expr    := term (('+' | '-') term)*
-    term    := unary (('*' | '/') unary)*
-    unary   := '-' unary | power
-    power   := atom ('^' unary)?           -- right-associative; -x^2 = -(x^2)
-    atom    := number | name | name '(' expr (',' expr)* ')' | '(' expr ')'
+``eval``) of the grammar stated once, in ``model-macro/src/expr/mod.rs``
+(``models/README.md`` points there too).
 
 The YAML is read with PyYAML's ``BaseLoader`` (every scalar a string), so
 that YAML 1.1 quirks (``no``/``on``/``off`` read as booleans, ``1e-3`` read
 as a string) cannot differ from a YAML 1.2 reader: expressions keep their
 exact text and numbers are parsed here. Duplicate mapping keys are errors.
 
-Only the standard library and PyYAML are needed to load and validate a
-model; :func:`build_casadi` imports CasADi when called.
+Only the standard library and PyYAML are needed to load a model;
+:func:`build_casadi` imports CasADi when called. The language's rules are
+checked by the Rust front end only (see ``_validate``).
 """
 
 from __future__ import annotations
@@ -298,7 +294,7 @@ class Model:
     definitions: dict[str, str]  # ordered, name -> expression text
     kinetic: str
     potential: str
-    forces: dict[str, str]  # coordinate -> expression text
+    applied: dict[str, str]  # coordinate -> expression text (Q)
     constraints: list[Constraint]
     initial: dict[str, float]
     ast: dict = field(default_factory=dict)
@@ -311,23 +307,6 @@ class Model:
     def k(self) -> int:
         return len(self.constraints)
 
-    def closure(self, node) -> set[str]:
-        """Names an expression depends on, following definitions through to
-        coordinates, velocities, parameters, inputs, ``t`` and ``pi``."""
-        out: set[str] = set()
-        todo = list(free_names(node))
-        seen: set[str] = set()
-        while todo:
-            nm = todo.pop()
-            if nm in seen:
-                continue
-            seen.add(nm)
-            if nm in self.definitions:
-                todo.extend(free_names(self.ast[("definition", nm)]))
-            else:
-                out.add(nm)
-        return out
-
 
 _KEYS = {
     "name",
@@ -338,7 +317,7 @@ _KEYS = {
     "definitions",
     "kinetic",
     "potential",
-    "forces",
+    "applied",
     "constraints",
     "restitution",
     "initial",
@@ -385,6 +364,13 @@ def load_model_text(text: str, origin: str = "<model>") -> Model:
 
 
 def _validate(doc) -> Model:
+    """Reads the model's structure. The rules of the language (unique and
+    reserved names, declared names, restitution in [0, 1], what T, V and h
+    may depend on, ...) are the Rust front end's alone (model-macro's
+    `check.rs` and `resolve.rs`): every model this tool reads has compiled
+    through `model!` first (the shipped files, or `ModelInfo::source` of a
+    compiled type), so a second copy of the rules here could only drift.
+    What stays is what reading needs: the shapes of the YAML values."""
     if not isinstance(doc, dict):
         raise ModelError("the model must be a YAML mapping")
     unknown = sorted(set(doc) - _KEYS)
@@ -402,10 +388,6 @@ def _validate(doc) -> Model:
     kinds: dict[str, str] = {}  # name -> what it is, for uniqueness
 
     def declare(nm: str, what: str) -> None:
-        if nm in RESERVED:
-            raise ModelError(f"{what} {nm!r}: the name is reserved (function, t or pi)")
-        if nm in kinds:
-            raise ModelError(f"{what} {nm!r}: the name is already used by a {kinds[nm]}")
         kinds[nm] = what
 
     coords_raw = doc["coordinates"]
@@ -456,27 +438,12 @@ def _validate(doc) -> Model:
         dn = _ident(dn, "definitions")
         text = _expr_text(dv, f"definitions.{dn}")
         node = _parse_in(text, f"definitions.{dn}")
-        # Each definition may use the names declared so far (not itself, not later ones).
-        for ref in sorted(free_names(node)):
-            if ref not in kinds and ref not in BUILTIN_NAMES:
-                later = ref in defs_raw
-                raise ModelError(
-                    f"definitions.{dn}: "
-                    + (
-                        f"{ref!r} is defined later (definitions are ordered)"
-                        if later
-                        else f"unknown name {ref!r}"
-                    )
-                )
         declare(dn, "definition")
         definitions[dn] = text
         ast[("definition", dn)] = node
 
     def expr(role_key, text, where):
         node = _parse_in(text, where)
-        for ref in sorted(free_names(node)):
-            if ref not in kinds and ref not in BUILTIN_NAMES:
-                raise ModelError(f"{where}: unknown name {ref!r}")
         ast[role_key] = node
         return text
 
@@ -485,22 +452,18 @@ def _validate(doc) -> Model:
         ("potential",), _expr_text(doc.get("potential", "0"), "potential"), "potential"
     )
 
-    forces_raw = doc.get("forces", {})
-    if forces_raw in ("", None):
-        forces_raw = {}
-    if not isinstance(forces_raw, dict):
-        raise ModelError("forces: expected a mapping `coordinate: expression`")
-    forces = {}
-    for qn, fv in forces_raw.items():
-        if qn not in coordinates:
-            raise ModelError(f"forces: {qn!r} is not a coordinate")
-        forces[qn] = expr(("force", qn), _expr_text(fv, f"forces.{qn}"), f"forces.{qn}")
+    applied_raw = doc.get("applied", {})
+    if applied_raw in ("", None):
+        applied_raw = {}
+    if not isinstance(applied_raw, dict):
+        raise ModelError("applied: expected a mapping `coordinate: expression`")
+    applied = {}
+    for qn, fv in applied_raw.items():
+        applied[qn] = expr(("force", qn), _expr_text(fv, f"applied.{qn}"), f"applied.{qn}")
 
     default_e = None
     if "restitution" in doc:
         default_e = _number(doc["restitution"], "restitution")
-        if not 0.0 <= default_e <= 1.0:
-            raise ModelError(f"restitution: {default_e} is not in [0, 1]")
 
     cons_raw = doc.get("constraints", [])
     if cons_raw in ("", None):
@@ -508,7 +471,6 @@ def _validate(doc) -> Model:
     if not isinstance(cons_raw, list):
         raise ModelError("constraints: expected a list")
     constraints = []
-    cnames: set[str] = set()
     for i, entry in enumerate(cons_raw):
         if not isinstance(entry, dict):
             raise ModelError(f"constraints[{i}]: expected a mapping with name and h")
@@ -518,15 +480,10 @@ def _validate(doc) -> Model:
         if "name" not in entry or "h" not in entry:
             raise ModelError(f"constraints[{i}]: needs `name` and `h`")
         cn = _ident(entry["name"], f"constraints[{i}].name")
-        if cn in cnames:
-            raise ModelError(f"constraints: duplicate constraint name {cn!r}")
-        cnames.add(cn)
         h = expr(("constraint", cn), _expr_text(entry["h"], f"constraints.{cn}.h"),
                  f"constraints.{cn}.h")
         if "restitution" in entry:
             e = _number(entry["restitution"], f"constraints.{cn}.restitution")
-            if not 0.0 <= e <= 1.0:
-                raise ModelError(f"constraints.{cn}.restitution: {e} is not in [0, 1]")
         elif default_e is not None:
             e = default_e
         else:
@@ -542,8 +499,6 @@ def _validate(doc) -> Model:
         raise ModelError("initial: expected a mapping")
     initial = {}
     for nm, val in init_raw.items():
-        if nm not in coordinates and nm not in velocities:
-            raise ModelError(f"initial: {nm!r} is neither a coordinate nor a velocity")
         initial[nm] = _number(val, f"initial.{nm}")
 
     model = Model(
@@ -556,25 +511,12 @@ def _validate(doc) -> Model:
         definitions=definitions,
         kinetic=kinetic,
         potential=potential,
-        forces=forces,
+        applied=applied,
         constraints=constraints,
         initial=initial,
         ast=ast,
     )
 
-    # Dependency rules: T(q, v); V(q); h(q); Q(t, q, v, u).
-    vel, inp = set(velocities), set(inputs)
-    bad_for_qonly = vel | inp | {"t"}
-
-    def forbid(role_key, where, banned, rule):
-        hits = sorted(model.closure(ast[role_key]) & banned)
-        if hits:
-            raise ModelError(f"{where} may not depend on {', '.join(hits)} ({rule})")
-
-    forbid(("kinetic",), "kinetic", inp | {"t"}, "T = T(q, v)")
-    forbid(("potential",), "potential", bad_for_qonly, "V = V(q)")
-    for c in constraints:
-        forbid(("constraint", c.name), f"constraints.{c.name}.h", bad_for_qonly, "h = h(q)")
     return model
 
 
@@ -671,7 +613,7 @@ def build_casadi(model: Model) -> CasadiModel:
     V = _to_sx(model.ast[("potential",)], env, ca)
     Q = ca.SX.zeros(model.n, 1)
     for i, nm in enumerate(model.coordinates):
-        if nm in model.forces:
+        if nm in model.applied:
             Q[i] = _to_sx(model.ast[("force", nm)], env, ca)
     h = ca.SX.zeros(model.k, 1)
     for i, c in enumerate(model.constraints):

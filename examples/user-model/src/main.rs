@@ -19,7 +19,7 @@ moreau::model! {
     inputs { torque }
     kinetic = 0.5 * (m * l^2 / 3) * w^2;
     potential = m * g * 0.5 * l * sin(th);
-    forces { th: torque - b * w }
+    applied { th: torque - b * w }
     constraints { wall: th <= wall }
     restitution = 0.6;
 }

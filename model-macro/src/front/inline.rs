@@ -9,7 +9,7 @@
 //! let x_tip = l * sin(th);
 //! kinetic = 0.5 * m * (vx^2 + vy^2);
 //! potential = m * g * y;
-//! forces { x: -b * vx }
+//! applied { x: -b * vx }
 //! constraints { floor: y - x^2 >= 0, #[restitution = 0.5] ceiling: y <= c }
 //! restitution = 0.9;
 //! initial { x: 1.0, vx: 3.0 }
@@ -20,11 +20,12 @@
 
 use proc_macro2::{Delimiter, Group, Spacing, Span, TokenStream, TokenTree};
 
-use super::keys;
-use crate::ctxt::{Ctxt, Loc};
+use crate::ctxt::Ctxt;
 use crate::expr::{self, BinOp, Expr, ExprKind};
+use crate::keys;
+use crate::loc::Loc;
 use crate::spec::{
-    Constraint, Coordinate, Definition, Force, ModelSpec, Name, Number, Origin, Parameter,
+    Applied, Constraint, Coordinate, Definition, ModelSpec, Name, Number, Origin, Parameter,
 };
 
 /// Builds the model from the macro's tokens. Returns `None` only when the
@@ -62,7 +63,7 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         definitions: Vec::new(),
         kinetic: None,
         potential: None,
-        forces: Vec::new(),
+        applied: Vec::new(),
         constraints: Vec::new(),
         restitution: None,
         initial: Vec::new(),
@@ -185,12 +186,12 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
                 })
                 .collect();
         }
-        (keys::FORCES, [TokenTree::Group(g)]) => {
-            spec.forces = entries(cx, g)
+        (keys::APPLIED, [TokenTree::Group(g)]) => {
+            spec.applied = entries(cx, g)
                 .into_iter()
                 .filter_map(|e| {
                     let expr = e.expr(cx)?;
-                    Some(Force {
+                    Some(Applied {
                         coordinate: e.name,
                         expr,
                     })
@@ -224,14 +225,15 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
             }
         }
         (
-            keys::COORDINATES | keys::PARAMETERS | keys::INPUTS | keys::FORCES | keys::CONSTRAINTS
+            keys::COORDINATES | keys::PARAMETERS | keys::INPUTS | keys::APPLIED | keys::CONSTRAINTS
             | keys::INITIAL,
             _,
         ) => cx.error(loc, format!("expected `{key_text} {{ ... }}`")),
+        (keys::FORCES_RENAMED, _) => cx.error(loc, keys::forces_renamed()),
         (other, _) => cx.error(
             loc,
             format!(
-                "unknown item `{other}`; a model has coordinates, parameters, inputs, let, kinetic, potential, forces, constraints, restitution, initial"
+                "unknown item `{other}`; a model has coordinates, parameters, inputs, let, kinetic, potential, applied, constraints, restitution, initial"
             ),
         ),
     }

@@ -7,15 +7,17 @@
 
 use std::path::{Path, PathBuf};
 
-use proc_macro2::{Span, TokenStream};
+use proc_macro2::Span;
 use quote::quote;
 
-use super::keys;
 use super::yaml_tree::{YKind, YNode, YamlSource};
-use crate::ctxt::{Ctxt, Loc};
+use crate::ctxt::{Ctxt, Locate};
 use crate::expr::{self, Expr};
+use crate::keys;
+use crate::loc::Loc;
+use crate::loc::YamlPos;
 use crate::spec::{
-    Constraint, Coordinate, Definition, Force, ModelSpec, Name, Number, Origin, Parameter,
+    Applied, Constraint, Coordinate, Definition, ModelSpec, Name, Number, Origin, Parameter,
 };
 
 /// The arguments of the file form: `file = "path"`.
@@ -127,7 +129,7 @@ pub(crate) fn build(
         definitions: Vec::new(),
         kinetic: None,
         potential: None,
-        forces: Vec::new(),
+        applied: Vec::new(),
         constraints: Vec::new(),
         restitution: None,
         initial: Vec::new(),
@@ -189,12 +191,12 @@ pub(crate) fn build(
             }
             keys::KINETIC => spec.kinetic = w.expr(value),
             keys::POTENTIAL => spec.potential = w.expr(value),
-            keys::FORCES => {
-                spec.forces = w
-                    .entries(value, keys::FORCES)
+            keys::APPLIED => {
+                spec.applied = w
+                    .entries(value, keys::APPLIED)
                     .into_iter()
                     .filter_map(|(coordinate, v)| {
-                        Some(Force {
+                        Some(Applied {
                             coordinate,
                             expr: w.expr(v)?,
                         })
@@ -212,6 +214,10 @@ pub(crate) fn build(
                         Some((name, x))
                     })
                     .collect();
+            }
+            keys::FORCES_RENAMED => {
+                cx.error(k.loc, keys::forces_renamed());
+                continue;
             }
             other => {
                 cx.error(
@@ -412,8 +418,14 @@ impl Walker<'_> {
     }
 }
 
-/// `include_bytes!` of the model file, so that cargo rebuilds the user's
-/// crate when the file changes.
-pub(crate) fn track(path: &str) -> TokenStream {
-    quote! { const _: &[u8] = ::core::include_bytes!(#path); }
+/// The error context locates YAML errors through the source, handed to it
+/// as a value (`Ctxt::with_locator`).
+impl Locate for YamlSource {
+    fn describe(&self, pos: YamlPos) -> String {
+        YamlSource::describe(self, pos)
+    }
+
+    fn display(&self) -> &str {
+        &self.display
+    }
 }

@@ -12,8 +12,8 @@ use std::fmt;
 
 use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 
-use crate::ctxt::YamlPos;
 use crate::expr::fmt_number;
+use crate::loc::YamlPos;
 
 /// A YAML node and its index in document order.
 #[derive(Clone, Debug)]

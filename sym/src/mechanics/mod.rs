@@ -1,7 +1,7 @@
 //! Lagrangian mechanics: from `T`, `V`, `Q` and `h` to `M`, `C`, `G`, `F`, `J`.
 //!
 //! For coordinates `q`, velocities `v`, kinetic energy `T(q, v) = ½ vᵀ M(q) v`,
-//! potential `V(q)`, extra generalized forces `Q` and gaps `h(q) ≥ 0`, the
+//! potential `V(q)`, applied generalized forces `Q` and gaps `h(q) ≥ 0`, the
 //! equations of motion are `M(q) v̇ + F = 0` (the paper's (8)) with
 //!
 //! | quantity | formula |
@@ -65,9 +65,9 @@ pub struct Lagrangian<'a> {
     pub kinetic: Id,
     /// The potential energy `V(q)`.
     pub potential: Id,
-    /// The extra generalized forces `Q`, one per coordinate, or empty for
+    /// The applied generalized forces `Q`, one per coordinate, or empty for
     /// none.
-    pub forces: &'a [Id],
+    pub applied: &'a [Id],
     /// The gaps `h_i(q) ≥ 0`.
     pub gaps: &'a [Id],
 }
@@ -86,7 +86,7 @@ pub struct Lagrangian<'a> {
 ///     v: &[VarId(1)],
 ///     kinetic: t,
 ///     potential: zero,
-///     forces: &[],
+///     applied: &[],
 ///     gaps: &[],
 /// };
 /// let err = Mechanics::derive(&mut g, &sys).unwrap_err();
@@ -116,7 +116,7 @@ pub enum MechanicsError {
     VelocityFreeTerm,
     /// A slice of [`Lagrangian`] has the wrong length.
     Shape {
-        /// The field: `"v"` or `"forces"`.
+        /// The field: `"v"` or `"applied"`.
         what: &'static str,
         /// The length it should have (the number of coordinates).
         expected: usize,
@@ -188,7 +188,7 @@ impl std::error::Error for MechanicsError {}
 /// let x2 = g.powi(xe, 2);
 /// let v = g.mul(ke, x2);
 /// let v = g.mul(half, v); // V = ½ k x²
-/// let sys = Lagrangian { q: &[x], v: &[vx], kinetic: t, potential: v, forces: &[], gaps: &[xe] };
+/// let sys = Lagrangian { q: &[x], v: &[vx], kinetic: t, potential: v, applied: &[], gaps: &[xe] };
 /// let mech = Mechanics::derive(&mut g, &sys).unwrap();
 /// assert_eq!(mech.mass, vec![vec![me]]);
 /// assert!(g.is_zero(mech.coriolis[0][0]));
@@ -227,7 +227,7 @@ impl Mechanics {
     /// that `T` is a quadratic form in `v` (see the [module docs](self)).
     ///
     /// # Errors
-    /// [`MechanicsError::Shape`] if `v` or `forces` (unless empty) do not have
+    /// [`MechanicsError::Shape`] if `v` or `applied` (unless empty) do not have
     /// one entry per coordinate; [`MechanicsError::NotQuadratic`],
     /// [`MechanicsError::LinearTerm`] or [`MechanicsError::VelocityFreeTerm`]
     /// if `T` is not a quadratic form in `v`.
@@ -235,8 +235,8 @@ impl Mechanics {
     #[allow(clippy::needless_range_loop)]
     pub fn derive(g: &mut Graph, sys: &Lagrangian<'_>) -> Result<Mechanics, MechanicsError> {
         let n = sys.q.len();
-        for (what, found) in [("v", sys.v.len()), ("forces", sys.forces.len())] {
-            if found != n && !(what == "forces" && found == 0) {
+        for (what, found) in [("v", sys.v.len()), ("applied", sys.applied.len())] {
+            if found != n && !(what == "applied" && found == 0) {
                 return Err(MechanicsError::Shape {
                     what,
                     expected: n,
@@ -304,7 +304,7 @@ impl Mechanics {
             }
             let cv = sum(g, &terms);
             let f = g.add(cv, gravity[i]);
-            forces.push(match sys.forces.get(i) {
+            forces.push(match sys.applied.get(i) {
                 Some(&q) => g.sub(f, q),
                 None => f,
             });
@@ -387,7 +387,7 @@ impl Mechanics {
     /// let v = g.var(VarId(1));
     /// let t = g.powi(v, 2); // T = v², M = 2
     /// let zero = g.constant(0.0);
-    /// let sys = Lagrangian { q: &[VarId(0)], v: &[VarId(1)], kinetic: t, potential: zero, forces: &[], gaps: &[] };
+    /// let sys = Lagrangian { q: &[VarId(0)], v: &[VarId(1)], kinetic: t, potential: zero, applied: &[], gaps: &[] };
     /// let mech = Mechanics::derive(&mut g, &sys).unwrap();
     /// let outputs = mech.outputs();
     /// assert_eq!(outputs.len(), 7); // M, C, G, F, ∂F/∂q, ∂F/∂v, ∂(Mv)/∂q

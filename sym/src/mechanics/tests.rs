@@ -37,7 +37,7 @@ fn point_mass_under_gravity() {
         defs: &[],
         kinetic: "0.5 * m * (vx^2 + vy^2)",
         potential: "m * g * y",
-        forces: &[],
+        applied: &[],
         gaps: &[],
     }
     .build();
@@ -153,7 +153,7 @@ fn check_skew_and_lagrange(spec: &Spec, seed: u64) {
         assert!(vmv.abs() <= 1e-7 * scale * 16.0, "vᵀ(Ṁ − 2C)v = {vmv}");
         let f = b.g.eval(&mech.forces, &x);
         let gr = b.g.eval(&mech.gravity, &x);
-        let q = b.g.eval(&b.forces, &x);
+        let q = b.g.eval(&b.applied, &x);
         for i in 0..n {
             let mut tp = x.clone();
             let mut tm = x.clone();
@@ -197,7 +197,7 @@ fn kinetic_error(kinetic: &'static str) -> MechanicsError {
         defs: &[],
         kinetic,
         potential: "0",
-        forces: &[],
+        applied: &[],
         gaps: &[],
     }
     .build();
@@ -275,7 +275,7 @@ fn disguised_quadratic_forms_are_accepted() {
         defs: &[],
         kinetic: "0.5 * m * (vx + a)^2 - m * a * vx - 0.5 * m * a^2",
         potential: "0",
-        forces: &[],
+        applied: &[],
         gaps: &[],
     }
     .build();
@@ -292,7 +292,7 @@ fn shape_errors() {
         v: &[VarId(2)],
         kinetic: x,
         potential: x,
-        forces: &[],
+        applied: &[],
         gaps: &[],
     };
     assert_eq!(
@@ -305,11 +305,11 @@ fn shape_errors() {
     );
     let sys = Lagrangian {
         v: &[VarId(2), VarId(3)],
-        forces: &[x],
+        applied: &[x],
         ..sys
     };
     let err = Mechanics::derive(&mut g, &sys).unwrap_err();
-    assert_eq!(err.to_string(), "`forces` has 1 entries, expected 2");
+    assert_eq!(err.to_string(), "`applied` has 1 entries, expected 2");
 }
 
 #[test]

@@ -5,7 +5,7 @@ moreau::model! {
     parameters { m: 1.0, m: 2.0 }
     kinetic = 0.5 * m * (vx^2 + vy^2);
     potential = m * g * y;
-    forces { z: -vx }
+    applied { z: -vx }
     constraints { floor: y - x^2 + vx >= 0 }
     restitution = 2;
 }

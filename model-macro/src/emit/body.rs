@@ -1,0 +1,213 @@
+//! The straight-line body of one generated method, before it is printed:
+//! the variables it unpacks, its constants, its `let` bindings in order and
+//! one expression per output entry.
+//!
+//! Cut from the fused instruction list ([`Schedule::restrict`]) so that
+//! every method shares the fused evaluation's temporaries and computes
+//! nothing it does not return. A temporary used once is folded into its one
+//! consumer; the others are bound to a [`Local`] with a name that says what
+//! it holds (the output entry it is, a function of one variable, or an
+//! anonymous `a7`).
+
+use moreau_sym::{Func, Layout, Op, Operand, Schedule, VarId};
+
+use super::names::{Local, Names, Role};
+use crate::resolve::{Resolved, Var, VarLayout};
+
+/// An expression of the generated code.
+#[derive(Clone, Debug)]
+pub(crate) enum Code {
+    /// A bound name: a model variable, a constant or a temporary.
+    Local(Local),
+    Binary(Op, Box<Code>, Box<Code>),
+    Neg(Box<Code>),
+    /// `a.powi(n)`.
+    Powi(Box<Code>, i32),
+    /// `a.sin()`: the scalar's method of the function's name.
+    Func(Func, Box<Code>),
+    /// `a.powf(b)`.
+    Powf(Box<Code>, Box<Code>),
+    /// `y.atan2(x)`.
+    Atan2(Box<Code>, Box<Code>),
+}
+
+impl Code {
+    /// Binding strength: 1 for `+ -`, 2 for `* /`, 3 for unary minus, 4 for
+    /// postfix method calls and names.
+    pub fn precedence(&self) -> u8 {
+        match self {
+            Code::Binary(Op::Add | Op::Sub, ..) => 1,
+            Code::Binary(..) => 2,
+            Code::Neg(_) => 3,
+            _ => 4,
+        }
+    }
+
+    /// Calls `f` on every model variable the expression reads.
+    fn visit_vars(&self, f: &mut impl FnMut(Var)) {
+        match self {
+            Code::Local(Local::Var(v)) => f(*v),
+            Code::Local(_) => {}
+            Code::Binary(_, a, b) => {
+                a.visit_vars(f);
+                b.visit_vars(f);
+            }
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) => a.visit_vars(f),
+            Code::Powf(a, b) | Code::Atan2(a, b) => {
+                a.visit_vars(f);
+                b.visit_vars(f);
+            }
+        }
+    }
+}
+
+/// One `let` of a body: the local, its value and, for an output, the entry
+/// it is (for the listing's comment).
+pub(crate) struct Let {
+    pub local: Local,
+    pub code: Code,
+    pub entry: Option<String>,
+}
+
+/// A method body.
+pub(crate) struct Body {
+    /// The model variables read, in layout order (unpacked first).
+    pub unpack: Vec<Var>,
+    /// The constants, `Local::Const(i)` being `constants[i]`.
+    pub constants: Vec<f64>,
+    pub lets: Vec<Let>,
+    /// One expression per requested output, in the order requested.
+    pub outputs: Vec<Code>,
+    /// The printed names of every local.
+    pub names: Names,
+}
+
+/// The body computing the fused outputs `indices` (of `outputs`, the
+/// model's output layout) from the full schedule `full`.
+pub(crate) fn build(
+    model: &Resolved<'_>,
+    full: &Schedule,
+    outputs: &Layout,
+    indices: &[usize],
+) -> Body {
+    let sched = full.restrict(indices);
+    let uses = sched.use_counts();
+    let mut b = Builder {
+        model,
+        vars: model.layout,
+        names: Names::new(model),
+        constants: Vec::new(),
+        codes: Vec::with_capacity(sched.instrs.len()),
+        lets: Vec::new(),
+        temps: 0,
+    };
+    // An output names its temporary after the first entry it fills.
+    let mut output_of = vec![None; sched.instrs.len()];
+    for (out, &index) in sched.outputs.iter().zip(indices) {
+        if let Operand::Tmp(t) = *out {
+            output_of[t as usize].get_or_insert(outputs.slot(index));
+        }
+    }
+    for (k, instr) in sched.instrs.iter().enumerate() {
+        let a = Box::new(b.operand(instr.args[0]));
+        let mut second = || Box::new(b.operand(instr.args[1]));
+        let code = match instr.op {
+            Op::Neg => Code::Neg(a),
+            Op::Powi(n) => Code::Powi(a, n),
+            Op::Func(f) => Code::Func(f, a),
+            Op::Pow => Code::Powf(a, second()),
+            Op::Atan2 => Code::Atan2(a, second()),
+            op @ (Op::Add | Op::Sub | Op::Mul | Op::Div) => Code::Binary(op, a, second()),
+        };
+        let code = match output_of[k] {
+            Some(slot) => b.bind(Local::Output(slot), code, Some(slot.describe())),
+            // Fold a temporary into its only consumer.
+            None if uses[k] == 1 => code,
+            None => {
+                let local = role(&code).unwrap_or_else(|| {
+                    b.temps += 1;
+                    Local::Temp(b.temps - 1)
+                });
+                b.bind(local, code, None)
+            }
+        };
+        b.codes.push(code);
+    }
+    let outputs: Vec<Code> = sched.outputs.iter().map(|&o| b.operand(o)).collect();
+    let mut read = vec![false; b.vars.len()];
+    for code in b.lets.iter().map(|l| &l.code).chain(&outputs) {
+        code.visit_vars(&mut |v| read[b.vars.id(v).index()] = true);
+    }
+    let unpack = (0..b.vars.len())
+        .filter(|&i| read[i])
+        .map(|i| b.vars.var(VarId(i as u32)))
+        .collect();
+    Body {
+        unpack,
+        constants: b.constants,
+        lets: b.lets,
+        outputs,
+        names: b.names,
+    }
+}
+
+/// A role for a shared temporary that is a function of one variable.
+fn role(code: &Code) -> Option<Local> {
+    let var = |c: &Code| match c {
+        Code::Local(Local::Var(v)) => Some(*v),
+        _ => None,
+    };
+    match code {
+        Code::Func(f, a) => var(a).map(|v| Local::Role(Role::Func(*f), v)),
+        Code::Powi(a, 2) => var(a).map(|v| Local::Role(Role::Square, v)),
+        Code::Powi(a, 3) => var(a).map(|v| Local::Role(Role::Cube, v)),
+        _ => None,
+    }
+}
+
+struct Builder<'a, 'm> {
+    model: &'a Resolved<'m>,
+    vars: VarLayout,
+    names: Names,
+    constants: Vec<f64>,
+    /// The code of each instruction so far: folded, or its bound local.
+    codes: Vec<Code>,
+    lets: Vec<Let>,
+    temps: usize,
+}
+
+impl Builder<'_, '_> {
+    fn operand(&mut self, a: Operand) -> Code {
+        match a {
+            Operand::Const(c) => Code::Local(self.constant(c)),
+            Operand::Var(v) => Code::Local(Local::Var(self.vars.var(v))),
+            Operand::Tmp(t) => self.codes[t as usize].clone(),
+        }
+    }
+
+    fn constant(&mut self, c: f64) -> Local {
+        let i = match self
+            .constants
+            .iter()
+            .position(|x| x.to_bits() == c.to_bits())
+        {
+            Some(i) => i,
+            None => {
+                self.constants.push(c);
+                let local = Local::Const(self.constants.len() - 1);
+                let readable = local.readable(self.model, c);
+                self.names.declare(local, readable);
+                self.constants.len() - 1
+            }
+        };
+        Local::Const(i)
+    }
+
+    /// Binds `code` to `local` and returns the code that reads it.
+    fn bind(&mut self, local: Local, code: Code, entry: Option<String>) -> Code {
+        let readable = local.readable(self.model, 0.0);
+        self.names.declare(local, readable);
+        self.lets.push(Let { local, code, entry });
+        Code::Local(local)
+    }
+}

@@ -1,0 +1,149 @@
+//! Emission: straight-line Rust from one instruction list.
+//!
+//! Every output of the model is an entry of one [`Schedule`], built once
+//! from `Mechanics::outputs` (in the one output layout of
+//! `moreau_sym::Layout`) after common-subexpression elimination. Each
+//! generated method evaluates the sub-list its quantities need, so `eval`
+//! shares every temporary and `mass` computes nothing else.
+//!
+//! | file | emits |
+//! |---|---|
+//! | `names.rs` | what a binding is ([`Local`](names::Local)) and its printed name |
+//! | `body.rs` | one method's straight-line body, from the schedule |
+//! | `print.rs` | the one printer: tokens for the code, text for the listing |
+//! | `items.rs` | the generated type: struct, `Default`, inherent items, trait impls, docs |
+//! | `fallback.rs` | the struct and stub impls for a model with errors |
+//!
+//! The code is written as a careful person would: inputs unpacked once at
+//! the top under the model's own names (`let th1 = q[0];`), temporaries
+//! used once folded into their one consumer, the others bound to names that
+//! say what they hold (`m_0_1` for `M[0,1]`, `sin_th1`, `a7` for anonymous
+//! shared ones), constants bound once (`k_0_5`), and the symmetric `M`
+//! filled from its upper triangle.
+
+mod body;
+mod fallback;
+mod items;
+mod names;
+mod print;
+
+pub(crate) use fallback::fallback;
+
+use moreau_sym::{Layout, Quantity, Schedule, Slot};
+use proc_macro2::{Literal, TokenStream};
+use quote::quote;
+
+use crate::lower::Lowered;
+use crate::resolve::Resolved;
+use body::Body;
+use print::{Text, Tokens};
+
+/// The generated items for a resolved, lowered model.
+pub(crate) fn emit(model: &Resolved<'_>, lowered: &Lowered) -> TokenStream {
+    Emitter::new(model, lowered).items()
+}
+
+/// The fused evaluation as annotated text (the snapshot tests read it).
+#[cfg(test)]
+pub(crate) fn listing(model: &Resolved<'_>, lowered: &Lowered) -> String {
+    Emitter::new(model, lowered).listing()
+}
+
+/// Everything emission needs about one model.
+pub(crate) struct Emitter<'a, 'm> {
+    model: &'a Resolved<'m>,
+    outputs: Layout,
+    full: Schedule,
+}
+
+impl<'a, 'm> Emitter<'a, 'm> {
+    fn new(model: &'a Resolved<'m>, lowered: &Lowered) -> Self {
+        let mech = &lowered.mechanics;
+        Emitter {
+            model,
+            outputs: mech.layout(),
+            full: Schedule::new(&lowered.graph, &mech.outputs()),
+        }
+    }
+
+    /// The body computing every entry of `qs`.
+    fn body(&self, qs: &[Quantity]) -> (Vec<usize>, Body) {
+        let indices = self.outputs.indices(qs);
+        let body = body::build(self.model, &self.full, &self.outputs, &indices);
+        (indices, body)
+    }
+
+    /// Number of operations of the fused evaluation (`ModelInfo::op_count`).
+    fn op_count(&self) -> usize {
+        self.full
+            .restrict(&self.outputs.indices(&Quantity::EVAL))
+            .op_count()
+    }
+
+    /// One method body computing the quantities `qs` and returning them as
+    /// `ret` builds from the matrix of each quantity, in the order of `qs`.
+    fn method_body(
+        &self,
+        qs: &[Quantity],
+        ret: impl FnOnce(&[TokenStream]) -> TokenStream,
+    ) -> TokenStream {
+        let (indices, body) = self.body(qs);
+        let model = self.model;
+        let statements = Tokens::of(|t| print::statements(t, model, &body));
+        let entry = |slot: Slot| {
+            let index = self.outputs.index(slot);
+            let pos = indices.iter().position(|&i| i == index).unwrap_or(0);
+            Tokens::of(|t| print::code(t, &body.names, model, &body.outputs[pos]))
+        };
+        let (n, k) = (model.n(), model.k());
+        let matrices: Vec<TokenStream> = qs
+            .iter()
+            .map(|&quantity| {
+                let (rows, cols) = quantity.shape(n, k);
+                matrix(rows, cols, |row, col| entry(Slot { quantity, row, col }))
+            })
+            .collect();
+        let value = ret(&matrices);
+        quote! { #statements #value }
+    }
+
+    /// The fused evaluation as text, with comments naming matrix entries.
+    fn listing(&self) -> String {
+        let (indices, body) = self.body(&Quantity::EVAL);
+        let mut text = Text(format!(
+            "// {}: fused evaluation of M, C, G, F, h, J ({} operations)\n",
+            self.model.spec.name.text,
+            self.op_count()
+        ));
+        print::statements(&mut text, self.model, &body);
+        for (&index, code) in indices.iter().zip(&body.outputs) {
+            let slot = self.outputs.slot(index);
+            let mut value = Text::default();
+            print::code(&mut value, &body.names, self.model, code);
+            if value.0 != body.names.get(names::Local::Output(slot)) {
+                text.0
+                    .push_str(&format!("// {} = {}\n", slot.describe(), value.0));
+            }
+        }
+        text.0
+    }
+}
+
+/// A column-major `SMatrix` of `rows × cols` from entries `at(i, j)`.
+fn matrix(rows: usize, cols: usize, at: impl Fn(usize, usize) -> TokenStream) -> TokenStream {
+    let columns = (0..cols).map(|j| {
+        let entries = (0..rows).map(|i| at(i, j));
+        quote!([#(#entries),*])
+    });
+    quote!(::moreau::__private::SMatrix::from_array_storage(
+        ::moreau::__private::ArrayStorage([#(#columns),*])
+    ))
+}
+
+/// An integer literal without a suffix (`2`, not `2usize`).
+fn int(n: usize) -> Literal {
+    Literal::usize_unsuffixed(n)
+}
+
+#[cfg(test)]
+mod tests;

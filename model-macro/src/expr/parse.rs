@@ -1,0 +1,280 @@
+//! The parser: one recursive descent over [`Tok`]s for both front ends.
+
+use moreau_sym::Function;
+
+use super::{BinOp, Expr, ExprKind, Tok, TokKind, fmt_number};
+use crate::ctxt::Ctxt;
+use crate::loc::Loc;
+
+/// How deeply an expression may nest (parentheses, unary minus, powers and
+/// calls each count one level). Every later stage recurses over the tree,
+/// so this bound is what keeps them all within the stack.
+pub(crate) const MAX_DEPTH: usize = 256;
+
+/// Parses a whole token list as one expression; `whole` locates the
+/// expression for errors at its end. Returns `None` after recording an error.
+///
+/// An unsupported function is reported and parsing goes on, so that every
+/// unsupported function of an expression is reported at once.
+pub(crate) fn parse(cx: &Ctxt, toks: &[Tok], whole: Loc) -> Option<Expr> {
+    let mut p = Parser {
+        cx,
+        toks,
+        pos: 0,
+        whole,
+        depth: 0,
+        failed: false,
+    };
+    if toks.is_empty() {
+        cx.error(whole, "expected an expression, found nothing");
+        return None;
+    }
+    let e = p.expr()?;
+    if let Some(t) = p.peek() {
+        let what = describe(&t.kind);
+        cx.error(t.loc, format!("expected an operator, found {what}"));
+        return None;
+    }
+    (!p.failed).then_some(e)
+}
+
+struct Parser<'a> {
+    cx: &'a Ctxt,
+    toks: &'a [Tok],
+    pos: usize,
+    whole: Loc,
+    /// Current nesting depth, bounded by [`MAX_DEPTH`].
+    depth: usize,
+    /// An error was recorded but parsing went on.
+    failed: bool,
+}
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<&Tok> {
+        self.toks.get(self.pos)
+    }
+
+    fn eat_op(&mut self, ops: &[char]) -> Option<(char, Loc)> {
+        match self.peek() {
+            Some(Tok {
+                kind: TokKind::Op(c),
+                loc,
+            }) if ops.contains(c) => {
+                let found = (*c, *loc);
+                self.pos += 1;
+                Some(found)
+            }
+            _ => None,
+        }
+    }
+
+    fn expr(&mut self) -> Option<Expr> {
+        let mut lhs = self.term()?;
+        while let Some((c, loc)) = self.eat_op(&['+', '-']) {
+            let op = if c == '+' { BinOp::Add } else { BinOp::Sub };
+            let rhs = self.term()?;
+            lhs = binary(op, lhs, rhs, loc);
+        }
+        Some(lhs)
+    }
+
+    fn term(&mut self) -> Option<Expr> {
+        let mut lhs = self.unary()?;
+        while let Some((c, loc)) = self.eat_op(&['*', '/']) {
+            let op = if c == '*' { BinOp::Mul } else { BinOp::Div };
+            let rhs = self.unary()?;
+            lhs = binary(op, lhs, rhs, loc);
+        }
+        Some(lhs)
+    }
+
+    /// Enters one level of nesting; an error past [`MAX_DEPTH`].
+    fn nest(&mut self, loc: Loc) -> Option<()> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            self.cx.error(
+                loc,
+                format!(
+                    "expression nested more than {MAX_DEPTH} levels deep; split it with definitions"
+                ),
+            );
+            return None;
+        }
+        Some(())
+    }
+
+    fn unary(&mut self) -> Option<Expr> {
+        let loc = self.peek().map_or(self.whole, |t| t.loc);
+        self.nest(loc)?;
+        let e = self.unary_inner();
+        self.depth -= 1;
+        e
+    }
+
+    fn unary_inner(&mut self) -> Option<Expr> {
+        if let Some((_, loc)) = self.eat_op(&['-']) {
+            let inner = self.unary()?;
+            return Some(Expr {
+                kind: ExprKind::Neg(Box::new(inner)),
+                loc,
+            });
+        }
+        if let Some((_, loc)) = self.eat_op(&['+']) {
+            self.cx.error(loc, "unary `+` is not allowed; remove it");
+            return None;
+        }
+        self.power()
+    }
+
+    fn power(&mut self) -> Option<Expr> {
+        let base = self.atom()?;
+        if let Some((_, loc)) = self.eat_op(&['^']) {
+            let exponent = self.unary()?;
+            return Some(binary(BinOp::Pow, base, exponent, loc));
+        }
+        Some(base)
+    }
+
+    fn atom(&mut self) -> Option<Expr> {
+        let Some(tok) = self.peek().cloned() else {
+            self.cx.error(
+                self.end_loc(),
+                "expression ends where an operand is expected",
+            );
+            return None;
+        };
+        self.pos += 1;
+        match tok.kind {
+            TokKind::Num(x) => Some(Expr {
+                kind: ExprKind::Num(x),
+                loc: tok.loc,
+            }),
+            TokKind::Ident(name) => {
+                if matches!(
+                    self.peek(),
+                    Some(Tok {
+                        kind: TokKind::Open,
+                        ..
+                    })
+                ) {
+                    self.pos += 1;
+                    self.call(name, tok.loc)
+                } else {
+                    Some(Expr {
+                        kind: ExprKind::Name(name),
+                        loc: tok.loc,
+                    })
+                }
+            }
+            TokKind::Open => {
+                let inner = self.expr()?;
+                self.close(tok.loc)?;
+                Some(inner)
+            }
+            other => {
+                let what = describe(&other);
+                self.cx.error(
+                    tok.loc,
+                    format!("expected a number, a name or `(`, found {what}"),
+                );
+                None
+            }
+        }
+    }
+
+    fn call(&mut self, name: String, loc: Loc) -> Option<Expr> {
+        let func = Function::from_name(&name);
+        let mut args = vec![self.expr()?];
+        while matches!(
+            self.peek(),
+            Some(Tok {
+                kind: TokKind::Comma,
+                ..
+            })
+        ) {
+            self.pos += 1;
+            args.push(self.expr()?);
+        }
+        self.close(loc)?;
+        let Some(func) = func else {
+            let names: Vec<&str> = Function::ALL.iter().map(|f| f.name()).collect();
+            self.cx.error(
+                loc,
+                format!(
+                    "unsupported function `{name}`; the model language has {}",
+                    names.join(", ")
+                ),
+            );
+            // Go on: later unsupported functions are reported too.
+            self.failed = true;
+            return Some(Expr {
+                kind: ExprKind::Num(0.0),
+                loc,
+            });
+        };
+        let kind = match func {
+            Function::Unary(f) => match <[Expr; 1]>::try_from(args) {
+                Ok([a]) => ExprKind::Func(f, Box::new(a)),
+                Err(args) => return self.arity_error(func, args.len(), loc),
+            },
+            Function::Atan2 => match <[Expr; 2]>::try_from(args) {
+                Ok([y, x]) => ExprKind::Atan2(Box::new(y), Box::new(x)),
+                Err(args) => return self.arity_error(func, args.len(), loc),
+            },
+        };
+        Some(Expr { kind, loc })
+    }
+
+    fn arity_error(&self, func: Function, found: usize, loc: Loc) -> Option<Expr> {
+        let arity = func.arity();
+        let plural = if arity == 1 { "" } else { "s" };
+        self.cx.error(
+            loc,
+            format!("`{func}` takes {arity} argument{plural}, found {found}"),
+        );
+        None
+    }
+
+    fn close(&mut self, open: Loc) -> Option<()> {
+        match self.peek() {
+            Some(Tok {
+                kind: TokKind::Close,
+                ..
+            }) => {
+                self.pos += 1;
+                Some(())
+            }
+            Some(t) => {
+                let what = describe(&t.kind);
+                self.cx.error(t.loc, format!("expected `)`, found {what}"));
+                None
+            }
+            None => {
+                self.cx.error(open, "this `(` is never closed");
+                None
+            }
+        }
+    }
+
+    fn end_loc(&self) -> Loc {
+        self.toks.last().map_or(self.whole, |t| t.loc)
+    }
+}
+
+fn binary(op: BinOp, a: Expr, b: Expr, loc: Loc) -> Expr {
+    Expr {
+        kind: ExprKind::Binary(op, Box::new(a), Box::new(b)),
+        loc,
+    }
+}
+
+fn describe(kind: &TokKind) -> String {
+    match kind {
+        TokKind::Num(x) => format!("the number `{}`", fmt_number(*x)),
+        TokKind::Ident(name) => format!("`{name}`"),
+        TokKind::Op(c) => format!("`{c}`"),
+        TokKind::Open => "`(`".into(),
+        TokKind::Close => "`)`".into(),
+        TokKind::Comma => "`,`".into(),
+    }
+}

@@ -1,0 +1,256 @@
+//! Resolution: every name of a checked [`ModelSpec`] becomes a typed
+//! [`Symbol`], once, and the model becomes a [`Resolved`] in which nothing
+//! is looked up by name again and nothing required is optional. Lowering
+//! and emission read only the resolved model.
+//!
+//! The [`Scope`] is the one table from names to symbols (a hash map, built
+//! once from the declarations); the checks ask it, resolution maps every
+//! expression through it. A graph variable is a [`Var`], numbered by
+//! [`VarLayout`] for `moreau-sym`.
+
+use std::collections::HashMap;
+
+use moreau_sym::VarId;
+
+use crate::expr::Expr;
+use crate::spec::{ModelSpec, Name};
+
+/// A variable of the model: what the generated code reads from its
+/// arguments or its fields.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Var {
+    Coordinate(usize),
+    Velocity(usize),
+    Time,
+    Input(usize),
+    Parameter(usize),
+}
+
+/// What a name in an expression stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Symbol {
+    Var(Var),
+    /// The `i`-th definition, in order.
+    Definition(usize),
+    /// The constant π.
+    Pi,
+}
+
+/// The one name table of a model: declared names (first declaration wins;
+/// duplicates are a check) and the reserved `t` and `pi`.
+pub(crate) struct Scope<'a> {
+    names: HashMap<&'a str, Symbol>,
+}
+
+impl<'a> Scope<'a> {
+    /// The scope of `spec`'s declarations.
+    pub fn new(spec: &'a ModelSpec) -> Scope<'a> {
+        let mut names = HashMap::new();
+        names.insert("t", Symbol::Var(Var::Time));
+        names.insert("pi", Symbol::Pi);
+        let mut add = |name: &'a Name, symbol| {
+            names.entry(name.text.as_str()).or_insert(symbol);
+        };
+        for (i, c) in spec.coordinates.iter().enumerate() {
+            add(&c.q, Symbol::Var(Var::Coordinate(i)));
+            add(&c.v, Symbol::Var(Var::Velocity(i)));
+        }
+        for (i, p) in spec.parameters.iter().enumerate() {
+            add(&p.name, Symbol::Var(Var::Parameter(i)));
+        }
+        for (i, u) in spec.inputs.iter().enumerate() {
+            add(u, Symbol::Var(Var::Input(i)));
+        }
+        for (i, d) in spec.definitions.iter().enumerate() {
+            add(&d.name, Symbol::Definition(i));
+        }
+        Scope { names }
+    }
+
+    /// What `name` stands for, if anything.
+    pub fn get(&self, name: &str) -> Option<Symbol> {
+        self.names.get(name).copied()
+    }
+
+    /// The index of the coordinate called `name`, if it is one.
+    pub fn coordinate(&self, name: &str) -> Option<usize> {
+        match self.get(name) {
+            Some(Symbol::Var(Var::Coordinate(i))) => Some(i),
+            _ => None,
+        }
+    }
+}
+
+/// The numbering of the model's variables in the symbolic graph:
+/// coordinates, velocities, time, inputs, parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct VarLayout {
+    pub n: usize,
+    pub inputs: usize,
+    pub parameters: usize,
+}
+
+impl VarLayout {
+    /// The graph variable of `var`.
+    pub fn id(&self, var: Var) -> VarId {
+        let n = self.n;
+        let index = match var {
+            Var::Coordinate(i) => i,
+            Var::Velocity(i) => n + i,
+            Var::Time => 2 * n,
+            Var::Input(i) => 2 * n + 1 + i,
+            Var::Parameter(i) => 2 * n + 1 + self.inputs + i,
+        };
+        VarId(u32::try_from(index).unwrap_or(u32::MAX))
+    }
+
+    /// What graph variable `id` stands for.
+    pub fn var(&self, id: VarId) -> Var {
+        let (n, i) = (self.n, id.index());
+        if i < n {
+            Var::Coordinate(i)
+        } else if i < 2 * n {
+            Var::Velocity(i - n)
+        } else if i == 2 * n {
+            Var::Time
+        } else if i < 2 * n + 1 + self.inputs {
+            Var::Input(i - 2 * n - 1)
+        } else {
+            Var::Parameter(i - 2 * n - 1 - self.inputs)
+        }
+    }
+
+    /// Number of graph variables.
+    pub fn len(&self) -> usize {
+        2 * self.n + 1 + self.inputs + self.parameters
+    }
+}
+
+/// A resolved model: the spec (for names, docs and locations) and every
+/// expression with typed symbols, in the shape the mechanics need.
+pub(crate) struct Resolved<'a> {
+    pub spec: &'a ModelSpec,
+    pub layout: VarLayout,
+    /// The definitions in order; each refers only to earlier ones.
+    pub definitions: Vec<Expr<Symbol>>,
+    pub kinetic: Expr<Symbol>,
+    pub potential: Option<Expr<Symbol>>,
+    /// The applied force on each coordinate, if any.
+    pub applied: Vec<Option<Expr<Symbol>>>,
+    /// The gap of each constraint.
+    pub gaps: Vec<Expr<Symbol>>,
+    /// The restitution coefficient of each constraint.
+    pub restitution: Vec<f64>,
+    /// Initial coordinates and velocities (0 where the model gives none).
+    pub initial_q: Vec<f64>,
+    pub initial_v: Vec<f64>,
+}
+
+impl Resolved<'_> {
+    /// Number of degrees of freedom `N`.
+    pub fn n(&self) -> usize {
+        self.layout.n
+    }
+
+    /// Number of constraints `K`.
+    pub fn k(&self) -> usize {
+        self.gaps.len()
+    }
+
+    /// The user's name of a variable (`t` for the time).
+    pub fn var_name(&self, var: Var) -> &str {
+        let spec = self.spec;
+        match var {
+            Var::Coordinate(i) => &spec.coordinates[i].q.text,
+            Var::Velocity(i) => &spec.coordinates[i].v.text,
+            Var::Time => "t",
+            Var::Input(i) => &spec.inputs[i].text,
+            Var::Parameter(i) => &spec.parameters[i].name.text,
+        }
+    }
+}
+
+/// Resolves every expression of a checked `spec` through `scope`. The
+/// checks have reported every name that stands for nothing and every
+/// definition used before it is defined; `None` if one is met anyway, or
+/// when the kinetic energy is missing (which the front ends report), and
+/// the caller then reports an internal error rather than emit wrong code.
+pub(crate) fn resolve<'a>(spec: &'a ModelSpec, scope: &Scope<'_>) -> Option<Resolved<'a>> {
+    let mut definitions = Vec::with_capacity(spec.definitions.len());
+    for (i, d) in spec.definitions.iter().enumerate() {
+        let e = d
+            .expr
+            .try_map(&mut |name: &String, _| match scope.get(name)? {
+                Symbol::Definition(j) if j >= i => None,
+                found => Some(found),
+            })?;
+        definitions.push(e);
+    }
+    let expr = |e: &Expr| e.try_map(&mut |name: &String, _| scope.get(name));
+    let kinetic = expr(spec.kinetic.as_ref()?)?;
+    let potential = match &spec.potential {
+        Some(p) => Some(expr(p)?),
+        None => None,
+    };
+    let mut applied: Vec<Option<Expr<Symbol>>> = vec![None; spec.dofs()];
+    for a in &spec.applied {
+        applied[scope.coordinate(&a.coordinate.text)?] = Some(expr(&a.expr)?);
+    }
+    let mut gaps = Vec::with_capacity(spec.constraint_count());
+    for c in &spec.constraints {
+        gaps.push(expr(&c.h)?);
+    }
+    let mut initial_q = vec![0.0; spec.dofs()];
+    let mut initial_v = vec![0.0; spec.dofs()];
+    for (name, x) in &spec.initial {
+        match scope.get(&name.text)? {
+            Symbol::Var(Var::Coordinate(i)) => initial_q[i] = x.value,
+            Symbol::Var(Var::Velocity(i)) => initial_v[i] = x.value,
+            _ => return None,
+        }
+    }
+    Some(Resolved {
+        spec,
+        layout: VarLayout {
+            n: spec.dofs(),
+            inputs: spec.inputs.len(),
+            parameters: spec.parameters.len(),
+        },
+        definitions,
+        kinetic,
+        potential,
+        applied,
+        gaps,
+        restitution: (0..spec.constraint_count())
+            .map(|i| spec.restitution_of(i).map_or(0.0, |e| e.value))
+            .collect(),
+        initial_q,
+        initial_v,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_round_trips_every_variable() {
+        let layout = VarLayout {
+            n: 3,
+            inputs: 2,
+            parameters: 4,
+        };
+        let mut all = Vec::new();
+        for i in 0..3 {
+            all.push(Var::Coordinate(i));
+            all.push(Var::Velocity(i));
+        }
+        all.push(Var::Time);
+        all.extend((0..2).map(Var::Input));
+        all.extend((0..4).map(Var::Parameter));
+        for var in all {
+            assert_eq!(layout.var(layout.id(var)), var);
+            assert!(layout.id(var).index() < layout.len());
+        }
+    }
+}

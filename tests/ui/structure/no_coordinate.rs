@@ -1,0 +1,7 @@
+moreau::model! {
+    pub struct Nothing;
+    coordinates { }
+    kinetic = 0;
+}
+
+fn main() {}

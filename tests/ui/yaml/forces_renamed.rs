@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/forces_renamed.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/keyword_name.yaml");
+
+fn main() {}

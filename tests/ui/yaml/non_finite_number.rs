@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/non_finite_number.yaml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/too_deep.yaml");
+
+fn main() {}
