@@ -147,7 +147,12 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
         return;
     }
     seen.push(key_text.clone());
-    match (key_text.as_str(), &item[1..]) {
+    read_keyed(cx, spec, &key_text, loc, &item[1..]);
+}
+
+/// Reads the item `key ...` (`rest` is what follows the key).
+fn read_keyed(cx: &Ctxt, spec: &mut ModelSpec, key_text: &str, loc: Loc, rest: &[TokenTree]) {
+    match (key_text, rest) {
         (keys::COORDINATES, [TokenTree::Group(g)]) => {
             spec.coordinates = entries(cx, g)
                 .into_iter()
@@ -170,22 +175,7 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
                 })
                 .collect();
         }
-        (keys::INPUTS, [TokenTree::Group(g)]) => {
-            spec.inputs = split_commas(g.stream())
-                .into_iter()
-                .filter_map(|tokens| match tokens.as_slice() {
-                    [TokenTree::Ident(i)] => Some(Name {
-                        text: i.to_string(),
-                        loc: Loc::span(i.span()),
-                    }),
-                    _ => {
-                        let span = tokens.first().map_or(g.span(), TokenTree::span);
-                        cx.error(Loc::span(span), "expected an input name");
-                        None
-                    }
-                })
-                .collect();
-        }
+        (keys::INPUTS, [TokenTree::Group(g)]) => spec.inputs = inputs(cx, g),
         (keys::APPLIED, [TokenTree::Group(g)]) => {
             spec.applied = entries(cx, g)
                 .into_iter()
@@ -215,15 +205,10 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
         }
         (keys::KINETIC, rest) => spec.kinetic = assigned_expr(cx, rest, loc, keys::KINETIC),
         (keys::POTENTIAL, rest) => spec.potential = assigned_expr(cx, rest, loc, keys::POTENTIAL),
-        (keys::RESTITUTION, rest) => {
-            spec.restitution = match rest {
-                [eq, value @ ..] if is_punct(eq, '=') => number(cx, value, loc),
-                _ => {
-                    cx.error(loc, "expected `restitution = <number>;`");
-                    None
-                }
-            }
+        (keys::RESTITUTION, [eq, value @ ..]) if is_punct(eq, '=') => {
+            spec.restitution = number(cx, value, loc);
         }
+        (keys::RESTITUTION, _) => cx.error(loc, "expected `restitution = <number>;`"),
         (
             keys::COORDINATES | keys::PARAMETERS | keys::INPUTS | keys::APPLIED | keys::CONSTRAINTS
             | keys::INITIAL,
@@ -237,6 +222,24 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
             ),
         ),
     }
+}
+
+/// `inputs { u1, u2 }`: names only.
+fn inputs(cx: &Ctxt, g: &Group) -> Vec<Name> {
+    split_commas(g.stream())
+        .into_iter()
+        .filter_map(|tokens| match tokens.as_slice() {
+            [TokenTree::Ident(i)] => Some(Name {
+                text: i.to_string(),
+                loc: Loc::span(i.span()),
+            }),
+            _ => {
+                let span = tokens.first().map_or(g.span(), TokenTree::span);
+                cx.error(Loc::span(span), "expected an input name");
+                None
+            }
+        })
+        .collect()
 }
 
 fn assigned_expr(cx: &Ctxt, rest: &[TokenTree], loc: Loc, key: &str) -> Option<Expr> {

@@ -145,6 +145,52 @@ pub(crate) fn build(
             cx.error(k.loc, format!("duplicate key `{first}`"));
             continue;
         }
+        if let Some(known) = w.top_level(&mut spec, &k, value) {
+            seen.push(known);
+        }
+    }
+    for (key, what) in [
+        (keys::NAME, "its name"),
+        (keys::COORDINATES, "its coordinates"),
+        (keys::KINETIC, "its kinetic energy"),
+    ] {
+        if !seen.contains(&key) {
+            cx.error(
+                w.loc(root),
+                format!("missing `{key}`: a model needs {what}"),
+            );
+        }
+    }
+    Some(spec)
+}
+
+/// Walks the tree, recording problems in the context.
+struct Walker<'a> {
+    cx: &'a Ctxt,
+    span: Span,
+}
+
+impl Walker<'_> {
+    /// `parameters:`, a mapping of names to default values.
+    fn parameters(&self, value: &YNode) -> Vec<Parameter> {
+        let w = self;
+        w.entries(value, keys::PARAMETERS)
+            .into_iter()
+            .filter_map(|(name, v)| {
+                let default = w.number(v, &format!("parameter `{}`", name.text))?;
+                Some(Parameter {
+                    name,
+                    default,
+                    doc: Vec::new(),
+                })
+            })
+            .collect()
+    }
+
+    /// Reads one top-level entry into `spec`; the key's constant, or `None`
+    /// (after recording why) when the key is unknown.
+    fn top_level(&self, spec: &mut ModelSpec, k: &Name, value: &YNode) -> Option<&'static str> {
+        let (w, cx) = (self, self.cx);
         match k.text.as_str() {
             keys::NAME => {
                 if let Some(name) = w.name(value, "the model's name") {
@@ -156,20 +202,7 @@ pub(crate) fn build(
                 None => w.expected(value, "a text for `doc`"),
             },
             keys::COORDINATES => spec.coordinates = w.coordinates(value),
-            keys::PARAMETERS => {
-                spec.parameters = w
-                    .entries(value, keys::PARAMETERS)
-                    .into_iter()
-                    .filter_map(|(name, v)| {
-                        let default = w.number(v, &format!("parameter `{}`", name.text))?;
-                        Some(Parameter {
-                            name,
-                            default,
-                            doc: Vec::new(),
-                        })
-                    })
-                    .collect();
-            }
+            keys::PARAMETERS => spec.parameters = w.parameters(value),
             keys::INPUTS => match &value.kind {
                 YKind::Seq(items) => {
                     spec.inputs = items.iter().filter_map(|i| w.name(i, "an input")).collect();
@@ -217,7 +250,7 @@ pub(crate) fn build(
             }
             keys::FORCES_RENAMED => {
                 cx.error(k.loc, keys::forces_renamed());
-                continue;
+                return None;
             }
             other => {
                 cx.error(
@@ -227,39 +260,12 @@ pub(crate) fn build(
                         keys::TOP_LEVEL.join(", ")
                     ),
                 );
-                continue;
+                return None;
             }
         }
-        seen.push(
-            keys::TOP_LEVEL
-                .iter()
-                .find(|t| **t == k.text)
-                .copied()
-                .unwrap_or(""),
-        );
+        keys::TOP_LEVEL.iter().find(|t| **t == k.text).copied()
     }
-    for (key, what) in [
-        (keys::NAME, "its name"),
-        (keys::COORDINATES, "its coordinates"),
-        (keys::KINETIC, "its kinetic energy"),
-    ] {
-        if !seen.contains(&key) {
-            cx.error(
-                w.loc(root),
-                format!("missing `{key}`: a model needs {what}"),
-            );
-        }
-    }
-    Some(spec)
-}
 
-/// Walks the tree, recording problems in the context.
-struct Walker<'a> {
-    cx: &'a Ctxt,
-    span: Span,
-}
-
-impl Walker<'_> {
     fn loc(&self, node: &YNode) -> Loc {
         Loc {
             span: self.span,

@@ -181,70 +181,8 @@ impl Env<'_> {
                     _ => return Err("unsupported binary operator".into()),
                 }))
             }
-            Expr::MethodCall(m) => {
-                let x = self.eval(&m.receiver)?.num()?;
-                let args: Vec<f64> = m
-                    .args
-                    .iter()
-                    .map(|a| self.eval(a).and_then(|v| v.num()))
-                    .collect::<Result<_, _>>()?;
-                let method = m.method.to_string();
-                let one = |f: fn(f64) -> f64| Ok(Value::Num(f(x)));
-                match (method.as_str(), args.as_slice()) {
-                    ("sin", []) => one(f64::sin),
-                    ("cos", []) => one(f64::cos),
-                    ("tan", []) => one(f64::tan),
-                    ("sqrt", []) => one(f64::sqrt),
-                    ("exp", []) => one(f64::exp),
-                    ("ln", []) => one(f64::ln),
-                    ("sinh", []) => one(f64::sinh),
-                    ("cosh", []) => one(f64::cosh),
-                    ("tanh", []) => one(f64::tanh),
-                    ("powi", [n]) => Ok(Value::Num(x.powi(*n as i32))),
-                    ("powf", [y]) => Ok(Value::Num(x.powf(*y))),
-                    ("atan2", [y]) => Ok(Value::Num(x.atan2(*y))),
-                    _ => Err(format!("unsupported method `{method}`")),
-                }
-            }
-            Expr::Call(c) => {
-                let Expr::Path(p) = &*c.func else {
-                    return Err("call of a non-path".into());
-                };
-                let f = p
-                    .path
-                    .segments
-                    .last()
-                    .ok_or("empty path")?
-                    .ident
-                    .to_string();
-                let mut args: Vec<Value> = c
-                    .args
-                    .iter()
-                    .map(|a| self.eval(a))
-                    .collect::<Result<_, _>>()?;
-                match (f.as_str(), args.len()) {
-                    ("cst" | "ArrayStorage", 1) => Ok(args.remove(0)),
-                    ("from_array_storage", 1) => {
-                        let Value::Array(columns) = args.remove(0) else {
-                            return Err("storage is not an array".into());
-                        };
-                        let cols = columns.len();
-                        let mut data = Vec::new();
-                        let mut rows = 0;
-                        for col in columns {
-                            let Value::Array(entries) = col else {
-                                return Err("column is not an array".into());
-                            };
-                            rows = entries.len();
-                            for x in entries {
-                                data.push(x.num()?);
-                            }
-                        }
-                        Ok(Value::Mat { rows, cols, data })
-                    }
-                    _ => Err(format!("unsupported call `{f}`")),
-                }
-            }
+            Expr::MethodCall(m) => self.method(m),
+            Expr::Call(c) => self.call(c),
             Expr::Array(a) => Ok(Value::Array(
                 a.elems
                     .iter()
@@ -297,6 +235,72 @@ impl Env<'_> {
                 "unsupported expression `{}`",
                 quote::quote!(#other)
             )),
+        }
+    }
+
+    fn method(&mut self, m: &syn::ExprMethodCall) -> Result<Value, String> {
+        let x = self.eval(&m.receiver)?.num()?;
+        let args: Vec<f64> = m
+            .args
+            .iter()
+            .map(|a| self.eval(a).and_then(|v| v.num()))
+            .collect::<Result<_, _>>()?;
+        let method = m.method.to_string();
+        let one = |f: fn(f64) -> f64| Ok(Value::Num(f(x)));
+        match (method.as_str(), args.as_slice()) {
+            ("sin", []) => one(f64::sin),
+            ("cos", []) => one(f64::cos),
+            ("tan", []) => one(f64::tan),
+            ("sqrt", []) => one(f64::sqrt),
+            ("exp", []) => one(f64::exp),
+            ("ln", []) => one(f64::ln),
+            ("sinh", []) => one(f64::sinh),
+            ("cosh", []) => one(f64::cosh),
+            ("tanh", []) => one(f64::tanh),
+            ("powi", [n]) => Ok(Value::Num(x.powi(*n as i32))),
+            ("powf", [y]) => Ok(Value::Num(x.powf(*y))),
+            ("atan2", [y]) => Ok(Value::Num(x.atan2(*y))),
+            _ => Err(format!("unsupported method `{method}`")),
+        }
+    }
+
+    fn call(&mut self, c: &syn::ExprCall) -> Result<Value, String> {
+        let Expr::Path(p) = &*c.func else {
+            return Err("call of a non-path".into());
+        };
+        let f = p
+            .path
+            .segments
+            .last()
+            .ok_or("empty path")?
+            .ident
+            .to_string();
+        let mut args: Vec<Value> = c
+            .args
+            .iter()
+            .map(|a| self.eval(a))
+            .collect::<Result<_, _>>()?;
+        match (f.as_str(), args.len()) {
+            ("cst" | "ArrayStorage", 1) => Ok(args.remove(0)),
+            ("from_array_storage", 1) => {
+                let Value::Array(columns) = args.remove(0) else {
+                    return Err("storage is not an array".into());
+                };
+                let cols = columns.len();
+                let mut data = Vec::new();
+                let mut rows = 0;
+                for col in columns {
+                    let Value::Array(entries) = col else {
+                        return Err("column is not an array".into());
+                    };
+                    rows = entries.len();
+                    for x in entries {
+                        data.push(x.num()?);
+                    }
+                }
+                Ok(Value::Mat { rows, cols, data })
+            }
+            _ => Err(format!("unsupported call `{f}`")),
         }
     }
 }

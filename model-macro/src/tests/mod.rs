@@ -1,6 +1,7 @@
 //! Tests of the whole pipeline, from model text to emitted tokens.
 
 mod adversarial;
+mod fuzz;
 mod interp;
 
 use std::str::FromStr;

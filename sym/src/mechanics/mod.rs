@@ -231,8 +231,6 @@ impl Mechanics {
     /// one entry per coordinate; [`MechanicsError::NotQuadratic`],
     /// [`MechanicsError::LinearTerm`] or [`MechanicsError::VelocityFreeTerm`]
     /// if `T` is not a quadratic form in `v`.
-    // Index loops mirror the formulas' indices (M_ij, Γ_ijk).
-    #[allow(clippy::needless_range_loop)]
     pub fn derive(g: &mut Graph, sys: &Lagrangian<'_>) -> Result<Mechanics, MechanicsError> {
         let n = sys.q.len();
         for (what, found) in [("v", sys.v.len()), ("applied", sys.applied.len())] {
@@ -244,93 +242,26 @@ impl Mechanics {
                 });
             }
         }
-        let zero = g.constant(0.0);
-
-        // p = ∂T/∂v, M_ij = ∂p_i/∂v_j for i ≤ j.
-        let momentum = g.gradient(sys.kinetic, sys.v);
-        let mut mass = vec![vec![zero; n]; n];
-        for i in 0..n {
-            for j in i..n {
-                let m = g.diff(momentum[i], sys.v[j]);
-                if let Some(k) = sys.v.iter().position(|&v| g.depends_on(m, v)) {
-                    return Err(MechanicsError::NotQuadratic {
-                        row: i,
-                        col: j,
-                        velocity: k,
-                    });
-                }
-                mass[i][j] = m;
-                mass[j][i] = m;
-            }
-        }
+        let (momentum, mass) = mass_matrix(g, sys)?;
         check_form(g, sys, &momentum)?;
-
-        // dm[i][j][k] = ∂M_ij/∂q_k, for i ≤ j (and mirrored).
-        let mut dm = vec![vec![Vec::new(); n]; n];
-        for i in 0..n {
-            for j in i..n {
-                let d = g.gradient(mass[i][j], sys.q);
-                dm[j][i].clone_from(&d);
-                dm[i][j] = d;
-            }
-        }
-        let mut coriolis = vec![vec![zero; n]; n];
-        for (i, row) in coriolis.iter_mut().enumerate() {
-            for (j, c) in row.iter_mut().enumerate() {
-                let mut terms = Vec::new();
-                for k in 0..n {
-                    let gamma = lincomb(
-                        g,
-                        &[(0.5, dm[i][j][k]), (0.5, dm[i][k][j]), (-0.5, dm[j][k][i])],
-                    );
-                    if !g.is_zero(gamma) {
-                        let vk = g.var(sys.v[k]);
-                        terms.push(g.mul(gamma, vk));
-                    }
-                }
-                *c = sum(g, &terms);
-            }
-        }
-
+        // dm[i][j][k] = ∂M_ij/∂q_k, shared by C and ∂(M v)/∂q.
+        let dm = mass_derivatives(g, sys, &mass);
+        let coriolis = coriolis(g, sys, &dm);
         let gravity = g.gradient(sys.potential, sys.q);
-        let mut forces = Vec::with_capacity(n);
-        for i in 0..n {
-            let mut terms = Vec::new();
-            for j in 0..n {
-                if !g.is_zero(coriolis[i][j]) {
-                    let vj = g.var(sys.v[j]);
-                    terms.push(g.mul(coriolis[i][j], vj));
-                }
-            }
-            let cv = sum(g, &terms);
-            let f = g.add(cv, gravity[i]);
-            forces.push(match sys.applied.get(i) {
-                Some(&q) => g.sub(f, q),
-                None => f,
-            });
-        }
+        let forces = total_forces(g, sys, &coriolis, &gravity);
         let jacobian = g.jacobian(sys.gaps, sys.q);
         let force_dq = g.jacobian(&forces, sys.q);
         let force_dv = g.jacobian(&forces, sys.v);
-        // ∂(M v)_i/∂q_j = Σ_k ∂M_ik/∂q_j v_k, from the shared ∂M/∂q.
-        let contract = |g: &mut Graph, d: &dyn Fn(usize) -> Id, k_max: usize| {
-            let mut terms = Vec::new();
-            for k in 0..k_max {
-                if !g.is_zero(d(k)) {
-                    let vk = g.var(sys.v[k]);
-                    terms.push(g.mul(d(k), vk));
-                }
-            }
-            sum(g, &terms)
-        };
+        // ∂(M v)_i/∂q_j = Σ_k ∂M_ik/∂q_j v_k.
         let mass_dq = (0..n)
-            .map(|i| (0..n).map(|j| contract(g, &|k| dm[i][k][j], n)).collect())
+            .map(|i| (0..n).map(|j| contract(g, sys, &|k| dm[i][k][j])).collect())
             .collect();
+        // ∂(J v)_i/∂q_j = Σ_k ∂J_ik/∂q_j v_k.
         let jacobian_dq = jacobian
             .iter()
             .map(|row: &Vec<Id>| {
                 let d: Vec<Vec<Id>> = row.iter().map(|&jk| g.gradient(jk, sys.q)).collect();
-                (0..n).map(|j| contract(g, &|k| d[k][j], n)).collect()
+                (0..n).map(|j| contract(g, sys, &|k| d[k][j])).collect()
             })
             .collect();
         Ok(Mechanics {
@@ -404,6 +335,116 @@ impl Mechanics {
             .map(|slot| self.get(slot))
             .collect()
     }
+}
+
+/// `p = ∂T/∂v` and `M_ij = ∂p_i/∂v_j` (built for `i ≤ j`, mirrored), after
+/// checking that no entry depends on a velocity.
+#[allow(clippy::needless_range_loop)]
+fn mass_matrix(
+    g: &mut Graph,
+    sys: &Lagrangian<'_>,
+) -> Result<(Vec<Id>, Vec<Vec<Id>>), MechanicsError> {
+    let n = sys.q.len();
+    let zero = g.constant(0.0);
+    let momentum = g.gradient(sys.kinetic, sys.v);
+    let mut mass = vec![vec![zero; n]; n];
+    for (i, &p) in momentum.iter().enumerate() {
+        for j in i..n {
+            let m = g.diff(p, sys.v[j]);
+            if let Some(k) = sys.v.iter().position(|&v| g.depends_on(m, v)) {
+                return Err(MechanicsError::NotQuadratic {
+                    row: i,
+                    col: j,
+                    velocity: k,
+                });
+            }
+            mass[i][j] = m;
+            mass[j][i] = m;
+        }
+    }
+    Ok((momentum, mass))
+}
+
+/// `dm[i][j][k] = ∂M_ij/∂q_k`, built for `i ≤ j` and mirrored.
+// Index loops mirror the formulas' indices (M_ij, Γ_ijk).
+#[allow(clippy::needless_range_loop)]
+fn mass_derivatives(g: &mut Graph, sys: &Lagrangian<'_>, mass: &[Vec<Id>]) -> Vec<Vec<Vec<Id>>> {
+    let n = mass.len();
+    let mut dm = vec![vec![Vec::new(); n]; n];
+    for i in 0..n {
+        for j in i..n {
+            let d = g.gradient(mass[i][j], sys.q);
+            dm[j][i].clone_from(&d);
+            dm[i][j] = d;
+        }
+    }
+    dm
+}
+
+// Index loops mirror the formulas' indices (M_ij, Γ_ijk).
+#[allow(clippy::needless_range_loop)]
+/// `C_ij = Σ_k Γ_ijk v_k` with `Γ_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)`.
+fn coriolis(g: &mut Graph, sys: &Lagrangian<'_>, dm: &[Vec<Vec<Id>>]) -> Vec<Vec<Id>> {
+    let n = dm.len();
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let row = (0..n)
+            .map(|j| {
+                let mut terms = Vec::new();
+                for k in 0..n {
+                    let gamma = lincomb(
+                        g,
+                        &[(0.5, dm[i][j][k]), (0.5, dm[i][k][j]), (-0.5, dm[j][k][i])],
+                    );
+                    if !g.is_zero(gamma) {
+                        let vk = g.var(sys.v[k]);
+                        terms.push(g.mul(gamma, vk));
+                    }
+                }
+                sum(g, &terms)
+            })
+            .collect();
+        out.push(row);
+    }
+    out
+}
+
+/// `F = C v + G − Q`, reusing the entries of `C`.
+fn total_forces(
+    g: &mut Graph,
+    sys: &Lagrangian<'_>,
+    coriolis: &[Vec<Id>],
+    gravity: &[Id],
+) -> Vec<Id> {
+    let mut forces = Vec::with_capacity(coriolis.len());
+    for (i, row) in coriolis.iter().enumerate() {
+        let mut terms = Vec::new();
+        for (j, &c) in row.iter().enumerate() {
+            if !g.is_zero(c) {
+                let vj = g.var(sys.v[j]);
+                terms.push(g.mul(c, vj));
+            }
+        }
+        let cv = sum(g, &terms);
+        let f = g.add(cv, gravity[i]);
+        forces.push(match sys.applied.get(i) {
+            Some(&q) => g.sub(f, q),
+            None => f,
+        });
+    }
+    forces
+}
+
+/// `Σ_k d(k) v_k`, skipping zero terms.
+fn contract(g: &mut Graph, sys: &Lagrangian<'_>, d: &dyn Fn(usize) -> Id) -> Id {
+    let mut terms = Vec::new();
+    for (k, &v) in sys.v.iter().enumerate() {
+        if !g.is_zero(d(k)) {
+            let vk = g.var(v);
+            terms.push(g.mul(d(k), vk));
+        }
+    }
+    sum(g, &terms)
 }
 
 /// Checks that `T = ½ vᵀ M v` given that `M` is free of velocities: `p` and
