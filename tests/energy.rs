@@ -105,9 +105,14 @@ fn double_pendulum_with_e_1_keeps_its_energy_over_a_million_steps() {
 
 /// With `e < 1` an impact never adds energy: on the undamped double
 /// pendulum (e = 0.8, through its impacts into sustained contact with the
-/// floor) no step with an impulse gains more energy than the largest
-/// error of a free-flight step of the same run (the flight inside an impact
-/// step is integrated by the same rule).
+/// floor) no step with an impulse gains more than the local energy error
+/// of the flight inside it. The law makes the impulses' work
+/// `½ (1 − e) min(J(q_k) v_k, 0) · λ ≤ 0` exactly; the flight's local
+/// error, for a second-order one-step method, is of order `(ωτ)³` times
+/// the energy in motion (`ω = max‖v‖∞`, `T_max` the largest kinetic
+/// energy), which is the bound. (Free-flight steps reach about that size,
+/// 3e-7 J here; the θ-method's default law gains 7.7e-6 J at its worst
+/// impact step of this run.)
 #[test]
 fn double_pendulum_with_e_below_1_never_gains_energy_at_an_impact() {
     let model = undamped_pendulum(0.8);
@@ -115,10 +120,13 @@ fn double_pendulum_with_e_below_1_never_gains_energy_at_an_impact() {
     let (q0, v0) = DoublePendulum::<f64>::initial_state();
     let mut state = State::new(0.0, q0, v0);
     let (mut impact_gain, mut flight_error, mut impulse_steps) = (f64::MIN, 0.0_f64, 0);
+    let (mut omega, mut kinetic_max) = (0.0_f64, 0.0_f64);
     while state.t < 100.0 {
         let before = pendulum_energy(&model, &state);
         let report = stepper.step(&model, &mut state, &SVector::zeros()).unwrap();
         let change = pendulum_energy(&model, &state) - before;
+        omega = omega.max(state.v.amax());
+        kinetic_max = kinetic_max.max(kinetic(&model, &state));
         if report.impacts().count() > 0 {
             impact_gain = impact_gain.max(change);
             impulse_steps += 1;
@@ -126,14 +134,12 @@ fn double_pendulum_with_e_below_1_never_gains_energy_at_an_impact() {
             flight_error = flight_error.max(change.abs());
         }
     }
+    let local = (omega * 1e-3).powi(3) * kinetic_max;
     eprintln!(
-        "double pendulum, e = 0.8, midpoint: {impulse_steps} steps with an impulse, largest gain {impact_gain:.2e} J; largest free-flight step error {flight_error:.2e} J"
+        "double pendulum, e = 0.8, midpoint: {impulse_steps} steps with an impulse, largest gain {impact_gain:.2e} J; largest free-flight step error {flight_error:.2e} J; (ωτ)³ T_max = {local:.2e} J"
     );
     assert!(impulse_steps > 100, "{impulse_steps}");
-    assert!(
-        impact_gain <= flight_error,
-        "{impact_gain:e} > {flight_error:e}"
-    );
+    assert!(impact_gain <= local, "{impact_gain:e} > {local:e}");
 }
 
 /// Where the flight is exact (constant `M`, no force) the midpoint law's
