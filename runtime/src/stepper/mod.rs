@@ -67,8 +67,8 @@
 //! impacts throw the pendulum into fast motion, where that drift is
 //! largest; the laws `Start` and `Slower` then add or remove energy at
 //! each impact as well (second column). With the θ-method the run ends in
-//! `LcpError::NotPositiveSemidefinite` at t = 369 s (`Start`) and
-//! t = 628.4 s (`Slower`).
+//! `LcpError::NotPositiveSemidefinite` at t = 369 s (`Start`), 580.4 s
+//! (`Iterate`) and 628.4 s (`Slower`).
 //!
 //! The midpoint step keeps the structure above (γ-prediction, one LCP per
 //! Newton iteration, `q_{k+1} = q_k + τ (θ v_{k+1} + (1 − θ) v_k)`, the same

@@ -52,7 +52,7 @@ pub struct StepParams<T> {
 /// | sliding on a curved surface | stays on it | bounces off it (`e` times the curvature term, every step) | stays on it | stays on it |
 /// | `e = 1` impacts on a dispersing obstacle | gains energy at every impact, without bound | keeps the energy exactly | keeps the energy exactly | keeps the energy exactly |
 /// | kinetic energy at an impact, no other force | may grow | may grow (sliding kicks) | never grows (one constraint) | never grows (any number of constraints) |
-/// | `e = 1`, configuration-dependent `M(q)` (double pendulum, `τ = 1e-3`) | runs away, LCP fails at 369 s | runs away | runs away, LCP fails at 628 s | bounded, within `3.5e-4 J` over `10⁷` steps |
+/// | `e = 1`, configuration-dependent `M(q)` (double pendulum, `τ = 1e-3`) | runs away, LCP fails at 369 s | runs away, LCP fails at 580 s | runs away, LCP fails at 628 s | bounded, within `3.5e-4 J` over `10⁷` steps |
 ///
 /// With `u = max(…)`, one constraint and no other force, the kinetic energy
 /// changes at an impact by `½ λ (J v_k − e u) ≤ 0`: the law never creates
