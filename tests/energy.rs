@@ -223,3 +223,39 @@ fn midpoint_law_slides_on_the_parabola() {
     eprintln!("Example 1, midpoint: floor active at every step from t = {last_free_step:.3} s");
     assert!((4.0..5.0).contains(&last_free_step), "{last_free_step}");
 }
+
+/// The midpoint step in `f32` (embedded targets) follows the `f64` one on
+/// the undamped double pendulum with e = 1, through its first impacts, to
+/// 1e-3 (the tolerance the θ-method's `f32` test uses on Example 1).
+#[test]
+fn midpoint_step_runs_in_f32() {
+    let m64 = undamped_pendulum(1.0);
+    let m32 = DoublePendulum::<f32> {
+        b: 0.0,
+        restitution: Vector2::repeat(1.0),
+        ..Default::default()
+    };
+    let s64 = midpoint(1e-3);
+    let mut params = StepParams::new(1e-3_f32);
+    params.approach_velocity = ApproachVelocity::Midpoint;
+    let s32 = MoreauJean::new(params).unwrap();
+    let (q0, v0) = DoublePendulum::<f64>::initial_state();
+    let (q1, v1) = DoublePendulum::<f32>::initial_state();
+    let mut a = State::new(0.0, q0, v0);
+    let mut b = State::new(0.0_f32, q1, v1);
+    let (mut impacts, mut worst) = (0, 0.0_f64);
+    for _ in 0..2000 {
+        let report = s64.step(&m64, &mut a, &SVector::zeros()).unwrap();
+        impacts += report.impacts().count();
+        s32.step(&m32, &mut b, &SVector::zeros()).unwrap();
+        let d = (a.q - b.q.cast::<f64>())
+            .amax()
+            .max((a.v - b.v.cast::<f64>()).amax());
+        assert!(d < 1e-3, "t = {}: {} vs {}", a.t, a.q, b.q);
+        worst = worst.max(d);
+    }
+    eprintln!(
+        "double pendulum, e = 1, midpoint, f32 against f64: {impacts} impacts in 2 s, worst {worst:.1e}"
+    );
+    assert!(impacts >= 2, "{impacts}");
+}
