@@ -14,6 +14,10 @@ use moreau_sym::{Func, Layout, Op, Operand, Schedule, VarId};
 use super::names::{Local, Names, Role};
 use crate::resolve::{Resolved, Var, VarLayout};
 
+/// The deepest an expression of the generated code may nest before its
+/// parts are bound to names.
+const MAX_FOLD_DEPTH: usize = 24;
+
 /// An expression of the generated code.
 #[derive(Clone, Debug)]
 pub(crate) enum Code {
@@ -40,6 +44,29 @@ impl Code {
             Code::Binary(..) => 2,
             Code::Neg(_) => 3,
             _ => 4,
+        }
+    }
+
+    /// Nesting depth of the expression (a name is 1).
+    pub fn depth(&self) -> usize {
+        match self {
+            Code::Local(_) => 1,
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) => 1 + a.depth(),
+            Code::Binary(_, a, b) | Code::Powf(a, b) | Code::Atan2(a, b) => {
+                1 + a.depth().max(b.depth())
+            }
+        }
+    }
+
+    /// Calls `f` on every local the expression reads (variables included).
+    pub fn visit_locals(&self, f: &mut impl FnMut(Local)) {
+        match self {
+            Code::Local(l) => f(*l),
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) => a.visit_locals(f),
+            Code::Binary(_, a, b) | Code::Powf(a, b) | Code::Atan2(a, b) => {
+                a.visit_locals(f);
+                b.visit_locals(f);
+            }
         }
     }
 
@@ -121,8 +148,11 @@ pub(crate) fn build(
         };
         let code = match output_of[k] {
             Some(slot) => b.bind(Local::Output(slot), code, Some(slot.describe())),
-            // Fold a temporary into its only consumer.
-            None if uses[k] == 1 => code,
+            // Fold a temporary into its only consumer, unless the folded
+            // expression would nest deeper than MAX_FOLD_DEPTH (a long sum
+            // `a + b + c + ...` is a left-deep tree; rustc's parser and
+            // lints recurse over it).
+            None if uses[k] == 1 && code.depth() < MAX_FOLD_DEPTH => code,
             None => {
                 let local = role(&code).unwrap_or_else(|| {
                     b.temps += 1;
@@ -131,7 +161,7 @@ pub(crate) fn build(
                 b.bind(local, code, None)
             }
         };
-        b.codes.push(code);
+        b.codes.push(Some(code));
     }
     let outputs: Vec<Code> = sched.outputs.iter().map(|&o| b.operand(o)).collect();
     let mut read = vec![false; b.vars.len()];
@@ -170,8 +200,10 @@ struct Builder<'a, 'm> {
     vars: VarLayout,
     names: Names,
     constants: Vec<f64>,
-    /// The code of each instruction so far: folded, or its bound local.
-    codes: Vec<Code>,
+    /// The code of each instruction so far: folded (taken by its one
+    /// consumer, so that a long chain is moved, never copied), or its bound
+    /// local.
+    codes: Vec<Option<Code>>,
     lets: Vec<Let>,
     temps: usize,
 }
@@ -181,7 +213,11 @@ impl Builder<'_, '_> {
         match a {
             Operand::Const(c) => Code::Local(self.constant(c)),
             Operand::Var(v) => Code::Local(Local::Var(self.vars.var(v))),
-            Operand::Tmp(t) => self.codes[t as usize].clone(),
+            Operand::Tmp(t) => match &mut self.codes[t as usize] {
+                Some(Code::Local(local)) => Code::Local(*local),
+                // a folded temporary has exactly one consumer: move it there
+                slot => slot.take().unwrap_or(Code::Local(Local::Temp(usize::MAX))),
+            },
         }
     }
 

@@ -12,7 +12,7 @@ use moreau_sym::Op;
 use proc_macro2::{Delimiter, Group, Ident, Literal, Punct, Spacing, Span, TokenStream, TokenTree};
 use quote::{ToTokens, quote};
 
-use super::body::{Body, Code};
+use super::body::{Body, Code, Let};
 use super::names::{Local, Names};
 use crate::expr::fmt_number;
 use crate::resolve::{Resolved, Var};
@@ -37,6 +37,14 @@ pub(crate) trait Sink {
     fn method(&mut self, name: &str, args: &mut dyn FnMut(&mut Self));
     /// `(` inner `)`.
     fn paren(&mut self, inner: &mut dyn FnMut(&mut Self));
+    /// A part of a long body: `let [outs] = part([ins]);` around a nested
+    /// function holding `body` (names with `true` are the user's).
+    fn part(
+        &mut self,
+        live_in: &[(&str, bool)],
+        live_out: &[(&str, bool)],
+        body: &mut dyn FnMut(&mut Self),
+    );
     /// `let name[: T] = value;` with an optional comment (text only).
     fn binding(
         &mut self,
@@ -121,7 +129,25 @@ pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) 
         let name = body.names.get(Local::Const(i));
         s.binding(&mut |s| s.internal(name), true, &mut |s| s.cst(value), None);
     }
-    for l in &body.lets {
+    if body.lets.len() <= PART {
+        lets(s, model, body, &body.lets);
+        return;
+    }
+    for part in parts(body) {
+        let name = |local: &Local| match local {
+            Local::Var(var) => (model.var_name(*var), true),
+            other => (body.names.get(*other), false),
+        };
+        let live_in: Vec<(&str, bool)> = part.live_in.iter().map(name).collect();
+        let live_out: Vec<(&str, bool)> = part.live_out.iter().map(name).collect();
+        s.part(&live_in, &live_out, &mut |s| {
+            lets(s, model, body, &body.lets[part.range.clone()]);
+        });
+    }
+}
+
+fn lets<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body, lets: &[Let]) {
+    for l in lets {
         let name = body.names.get(l.local);
         s.binding(
             &mut |s| s.internal(name),
@@ -130,6 +156,65 @@ pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) 
             l.entry.as_deref(),
         );
     }
+}
+
+/// The most bindings one function of the generated code holds: a longer
+/// body (a potential of thousands of terms) is cut into parts of this size,
+/// each a nested `#[inline(never)]` function taking the values it reads and
+/// returning those read after it, so that the compiler never sees one huge
+/// function (whose optimisation grows faster than linearly in its size).
+pub(crate) const PART: usize = 512;
+
+/// One part of a long body: its bindings, the locals it reads from before
+/// it, and the locals it defines that are read after it.
+struct Part {
+    range: std::ops::Range<usize>,
+    live_in: Vec<Local>,
+    live_out: Vec<Local>,
+}
+
+/// Cuts `body.lets` into parts of at most [`PART`] bindings.
+fn parts(body: &Body) -> Vec<Part> {
+    use std::collections::{HashMap, HashSet};
+    let defined: HashMap<Local, usize> = body
+        .lets
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (l.local, i / PART))
+        .collect();
+    let count = body.lets.len().div_ceil(PART);
+    let mut live_in: Vec<Vec<Local>> = vec![Vec::new(); count];
+    let mut live_out: Vec<Vec<Local>> = vec![Vec::new(); count];
+    let mut seen_in: Vec<HashSet<Local>> = vec![HashSet::new(); count];
+    let mut seen_out: Vec<HashSet<Local>> = vec![HashSet::new(); count];
+    let mut read = |reader: Option<usize>, local: Local| {
+        let home = defined.get(&local).copied();
+        if let Some(p) = reader
+            && home != Some(p)
+            && seen_in[p].insert(local)
+        {
+            live_in[p].push(local);
+        }
+        if let Some(h) = home
+            && reader != Some(h)
+            && seen_out[h].insert(local)
+        {
+            live_out[h].push(local);
+        }
+    };
+    for (i, l) in body.lets.iter().enumerate() {
+        l.code.visit_locals(&mut |local| read(Some(i / PART), local));
+    }
+    for out in &body.outputs {
+        out.visit_locals(&mut |local| read(None, local));
+    }
+    (0..count)
+        .map(|p| Part {
+            range: p * PART..((p + 1) * PART).min(body.lets.len()),
+            live_in: std::mem::take(&mut live_in[p]),
+            live_out: std::mem::take(&mut live_out[p]),
+        })
+        .collect()
 }
 
 fn index<S: Sink>(s: &mut S, arg: &str, i: usize) {
@@ -192,6 +277,38 @@ impl Sink for Tokens {
     }
     fn paren(&mut self, inner: &mut dyn FnMut(&mut Self)) {
         self.group(Delimiter::Parenthesis, inner);
+    }
+    fn part(
+        &mut self,
+        live_in: &[(&str, bool)],
+        live_out: &[(&str, bool)],
+        body: &mut dyn FnMut(&mut Self),
+    ) {
+        let ident = |&(name, user): &(&str, bool)| {
+            Ident::new(name, if user { Span::call_site() } else { Span::mixed_site() })
+        };
+        let ins: Vec<Ident> = live_in.iter().map(ident).collect();
+        let outs: Vec<Ident> = live_out.iter().map(ident).collect();
+        let (nin, nout) = (
+            Literal::usize_unsuffixed(ins.len()),
+            Literal::usize_unsuffixed(outs.len()),
+        );
+        let inner = Tokens::of(|t| body(t));
+        let (part, input) = (
+            Ident::new("part", Span::mixed_site()),
+            Ident::new("input", Span::mixed_site()),
+        );
+        self.0.extend(quote! {
+            let [#(#outs),*] = {
+                #[inline(never)]
+                fn #part<T: ::moreau::__private::RealField + ::core::marker::Copy>(#input: [T; #nin]) -> [T; #nout] {
+                    let [#(#ins),*] = #input;
+                    #inner
+                    [#(#outs),*]
+                }
+                #part([#(#ins),*])
+            };
+        });
     }
     fn binding(
         &mut self,
@@ -265,6 +382,20 @@ impl Sink for Text {
         self.0.push('(');
         inner(self);
         self.0.push(')');
+    }
+    fn part(
+        &mut self,
+        live_in: &[(&str, bool)],
+        live_out: &[(&str, bool)],
+        body: &mut dyn FnMut(&mut Self),
+    ) {
+        let names = |v: &[(&str, bool)]| v.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ");
+        self.0.push_str(&format!(
+            "// part ({}) -> ({})\n",
+            names(live_in),
+            names(live_out)
+        ));
+        body(self);
     }
     fn binding(
         &mut self,

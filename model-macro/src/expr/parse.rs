@@ -69,23 +69,21 @@ impl Parser<'_> {
     }
 
     fn expr(&mut self) -> Option<Expr> {
-        let mut lhs = self.term()?;
+        let first = self.term()?;
+        let mut rest = Vec::new();
         while let Some((c, loc)) = self.eat_op(&['+', '-']) {
-            let op = if c == '+' { BinOp::Add } else { BinOp::Sub };
-            let rhs = self.term()?;
-            lhs = binary(op, lhs, rhs, loc);
+            rest.push((c == '+', loc, self.term()?));
         }
-        Some(lhs)
+        Some(chain(first, rest, BinOp::Add, BinOp::Sub))
     }
 
     fn term(&mut self) -> Option<Expr> {
-        let mut lhs = self.unary()?;
+        let first = self.unary()?;
+        let mut rest = Vec::new();
         while let Some((c, loc)) = self.eat_op(&['*', '/']) {
-            let op = if c == '*' { BinOp::Mul } else { BinOp::Div };
-            let rhs = self.unary()?;
-            lhs = binary(op, lhs, rhs, loc);
+            rest.push((c == '*', loc, self.unary()?));
         }
-        Some(lhs)
+        Some(chain(first, rest, BinOp::Mul, BinOp::Div))
     }
 
     /// Enters one level of nesting; an error past [`MAX_DEPTH`].
@@ -258,6 +256,51 @@ impl Parser<'_> {
 
     fn end_loc(&self) -> Loc {
         self.toks.last().map_or(self.whole, |t| t.loc)
+    }
+}
+
+/// Chains longer than this are built as balanced trees.
+const LONG_CHAIN: usize = 64;
+
+/// `first op₁ t₁ op₂ t₂ …` for a left-associative pair of operators (`+ -`
+/// or `* /`; `true` in `rest` is the first of the pair). Up to
+/// [`LONG_CHAIN`] operands it is the left-deep tree of the text. A longer
+/// chain (a potential of 2000 terms) is built as a balanced tree of the same
+/// value in exact arithmetic (`a - b - c = a - (b + c)`), so that its depth,
+/// and the recursion of every later stage over it, grows with the logarithm
+/// of its length, not the length.
+fn chain(first: Expr, rest: Vec<(bool, Loc, Expr)>, direct: BinOp, inverse: BinOp) -> Expr {
+    if rest.len() < LONG_CHAIN {
+        return rest.into_iter().fold(first, |lhs, (is_direct, loc, rhs)| {
+            binary(if is_direct { direct } else { inverse }, lhs, rhs, loc)
+        });
+    }
+    // Signed operands; the first is direct, and a pair whose left operand
+    // is direct is direct, so the whole chain comes out direct.
+    let mut items = vec![(true, first.loc, first)];
+    items.extend(rest);
+    balanced(items, direct, inverse).2
+}
+
+/// Combines signed operands (at least one) pairwise, halves first.
+fn balanced(
+    mut items: Vec<(bool, Loc, Expr)>,
+    direct: BinOp,
+    inverse: BinOp,
+) -> (bool, Loc, Expr) {
+    if items.len() == 1 {
+        return items.remove(0);
+    }
+    let right = items.split_off(items.len() / 2);
+    let (da, la, a) = balanced(items, direct, inverse);
+    let (db, lb, b) = balanced(right, direct, inverse);
+    // (+a, +b) → +(a∘b); (+a, −b) → +(a∘⁻¹b); (−a, +b) → +(b∘⁻¹a);
+    // (−a, −b) → −(a∘b)
+    match (da, db) {
+        (true, true) => (true, la, binary(direct, a, b, lb)),
+        (true, false) => (true, la, binary(inverse, a, b, lb)),
+        (false, true) => (true, lb, binary(inverse, b, a, la)),
+        (false, false) => (false, la, binary(direct, a, b, lb)),
     }
 }
 

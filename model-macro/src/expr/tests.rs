@@ -107,3 +107,56 @@ fn inline_double_star_is_rejected() {
     assert!(tokenize_stream(&cx, stream).is_none());
     assert!(cx.check().unwrap_err().to_string().contains("`**`"));
 }
+
+/// The value of a numeric expression, for checking tree shapes.
+fn value(e: &Expr) -> f64 {
+    match &e.kind {
+        ExprKind::Num(x) => *x,
+        ExprKind::Neg(a) => -value(a),
+        ExprKind::Binary(op, a, b) => {
+            let (a, b) = (value(a), value(b));
+            match op {
+                BinOp::Add => a + b,
+                BinOp::Sub => a - b,
+                BinOp::Mul => a * b,
+                BinOp::Div => a / b,
+                BinOp::Pow => a.powf(b),
+            }
+        }
+        _ => f64::NAN,
+    }
+}
+
+fn depth(e: &Expr) -> usize {
+    match &e.kind {
+        ExprKind::Neg(a) | ExprKind::Func(_, a) => 1 + depth(a),
+        ExprKind::Binary(_, a, b) | ExprKind::Atan2(a, b) => 1 + depth(a).max(depth(b)),
+        _ => 1,
+    }
+}
+
+/// A chain of thousands of terms is a balanced tree of the same value (so
+/// that no later stage recurses thousands of levels); a short one keeps the
+/// left-deep shape of the text.
+#[test]
+fn long_chains_are_balanced_and_keep_their_value() {
+    let terms: Vec<String> = (0..3000)
+        .map(|i| format!("{} {}", if i % 3 == 0 { "-" } else { "+" }, 1 + i % 17))
+        .collect();
+    let text = format!("1 {}", terms.join(" "));
+    let e = parse_text(&text).unwrap();
+    let exact: f64 = 1.0
+        + (0..3000)
+            .map(|i| if i % 3 == 0 { -1.0 } else { 1.0 } * f64::from(1 + i % 17))
+            .sum::<f64>();
+    assert_eq!(value(&e), exact); // small integers: exact in any order
+    assert!(depth(&e) <= 14, "depth {}", depth(&e));
+    let factors: Vec<String> = (0..200)
+        .map(|i| format!("{} {}", if i % 2 == 0 { "*" } else { "/" }, 2))
+        .collect();
+    let e = parse_text(&format!("3 {}", factors.join(" "))).unwrap();
+    assert_eq!(value(&e), 3.0);
+    let short = parse_text("1 - 2 - 3 + 4").unwrap();
+    assert_eq!(depth(&short), 4);
+    assert_eq!(short.to_string(), "1 - 2 - 3 + 4");
+}
