@@ -8,8 +8,9 @@
 //! every measured figure.
 
 use moreau::{
-    Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, Model, ModelBounds,
-    MoreauJean, Observer, ObserverError, ObserverParams, ReducedOrder, State, StepParams,
+    DataError, Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, Model,
+    ModelBounds, MoreauJean, Observer, ObserverError, ObserverParams, ReducedOrder, State,
+    StepParams,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
@@ -61,8 +62,7 @@ where
             }
         }
         if k % every == 0 {
-            // the plant's t accumulates round-off: sample at exactly j τ_s
-            state.t = (k / every) as f64 * tau * every as f64;
+            // the stepper keeps t on its grid kτ: no round-off to correct
             samples.push(state);
         }
     }
@@ -1086,17 +1086,17 @@ fn bad_input_is_refused_and_the_state_kept() {
     let cases: [(Outcome, ObserverError<f64>); 7] = [
         (
             observer.update(&arm, last.t, &nan_q, &u),
-            ObserverError::NonFiniteMeasurement {
+            ObserverError::Data(DataError::NonFinite {
                 which: "q",
                 index: 1,
-            },
+            }),
         ),
         (
             observer.update(&arm, last.t, &Vector3::repeat(f64::INFINITY), &u),
-            ObserverError::NonFiniteMeasurement {
+            ObserverError::Data(DataError::NonFinite {
                 which: "q",
                 index: 0,
-            },
+            }),
         ),
         (
             observer.update(&arm, f64::NAN, &last.q, &u),
@@ -1114,20 +1114,20 @@ fn bad_input_is_refused_and_the_state_kept() {
         ),
         (
             observer.update(&arm, last.t, &last.q, &Vector3::new(0.0, 0.0, f64::NAN)),
-            ObserverError::NonFiniteInput { index: 2 },
+            ObserverError::Data(DataError::NonFiniteInput { index: 2 }),
         ),
         (
             observer.update(&bad_model, last.t, &last.q, &u),
-            ObserverError::NonFiniteParameter {
+            ObserverError::Data(DataError::NonFiniteParameter {
                 index: Arm3::<f64>::parameter_index("g").unwrap(),
-            },
+            }),
         ),
         (
             observer.update(&bad_e, last.t, &last.q, &u),
-            ObserverError::InvalidRestitution {
+            ObserverError::Data(DataError::InvalidRestitution {
                 constraint: 0,
                 value: 1.5,
-            },
+            }),
         ),
     ];
     for (result, expected) in cases {
@@ -1157,22 +1157,22 @@ fn bad_input_is_refused_and_the_state_kept() {
     };
     assert!(matches!(
         bad(ObserverParams::new(0.0, 1.0)),
-        ObserverError::InvalidParams { name: "l_d", .. }
+        ObserverError::Data(DataError::InvalidParams { name: "l_d", .. })
     ));
     assert!(matches!(
         bad(ObserverParams::new(f64::NAN, 1.0)),
-        ObserverError::InvalidParams { name: "l_d", .. }
+        ObserverError::Data(DataError::InvalidParams { name: "l_d", .. })
     ));
     assert!(matches!(
         bad(ObserverParams::new(1.0, -1.0)),
-        ObserverError::InvalidParams {
+        ObserverError::Data(DataError::InvalidParams {
             name: "velocity_bound",
             ..
-        }
+        })
     ));
     assert!(matches!(
         bad(ObserverParams::new(1.0, 1.0).with_noise(f64::NAN)),
-        ObserverError::InvalidParams { name: "noise", .. }
+        ObserverError::Data(DataError::InvalidParams { name: "noise", .. })
     ));
     let gains = FullOrderGains {
         lambda: SMatrix::<f64, 3, 3>::from_diagonal(&Vector3::new(1.0, -1.0, 1.0)),
@@ -1180,20 +1180,26 @@ fn bad_input_is_refused_and_the_state_kept() {
     };
     assert!(matches!(
         FullOrder::<f64, 3, 1>::new(params, gains, 0.0, start.q, start.v),
-        Err(ObserverError::InvalidParams { name: "lambda", .. })
+        Err(ObserverError::Data(DataError::InvalidParams {
+            name: "lambda",
+            ..
+        }))
     ));
     assert!(matches!(
         ReducedOrder::<f64, 3, 1>::new(params, 0.0, start.q, start.v)
             .unwrap()
             .with_restitution(SVector::repeat(-0.1)),
-        Err(ObserverError::InvalidRestitution { constraint: 0, .. })
+        Err(ObserverError::Data(DataError::InvalidRestitution {
+            constraint: 0,
+            ..
+        }))
     ));
     assert!(matches!(
         ReducedOrder::<f64, 3, 1>::new(params, 0.0, Vector3::new(0.0, f64::NAN, 0.0), start.v),
-        Err(ObserverError::NonFiniteMeasurement {
+        Err(ObserverError::Data(DataError::NonFinite {
             which: "q0",
             index: 1
-        })
+        }))
     ));
 }
 

@@ -6,12 +6,13 @@ use crate::lcp::Lcp;
 use crate::linalg::SymmetricEigen;
 use crate::model::Model;
 
-use super::interval::{Interval, Memory, factor_mass, finite, saturate};
+use super::interval::{Interval, Memory, saturate};
 use super::reduced_order::section_vii_impact;
 use super::{
-    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
-    check_restitution, check_vector,
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport, check_start,
 };
+use crate::error::DataError;
+use crate::validate::{self, factor_mass, finite_model};
 
 /// The gains `Λ` and `L_ρ1` of the full-order observer (36), both
 /// symmetric positive definite (`L_d = l_d I + Λ` and `L_ρ2 = l_d Λ` follow
@@ -40,7 +41,7 @@ impl<T: RealField + Copy, const N: usize> FullOrderGains<T, N> {
     /// positive definite.
     fn check(&self) -> Result<(), ObserverError<T>> {
         for (name, m) in [("lambda", &self.lambda), ("l_rho1", &self.l_rho1)] {
-            let bad = |value| ObserverError::InvalidParams { name, value };
+            let bad = |value| super::invalid(name, value);
             let asymmetry = (m - m.transpose()).amax();
             let tolerance = T::default_epsilon() * nalgebra::convert(1e3) * m.amax();
             if !asymmetry.is_finite() || asymmetry > tolerance {
@@ -127,10 +128,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a setting out of its range or a
+    /// [`DataError::InvalidParams`] for a setting out of its range or a
     /// gain matrix that is not symmetric positive definite (`"lambda"`,
     /// `"l_rho1"`, with the offending eigenvalue),
-    /// [`ObserverError::NonFiniteMeasurement`] or
+    /// [`DataError::NonFinite`] or
     /// [`ObserverError::InvalidTime`] for non-finite initial data.
     pub fn new(
         params: ObserverParams<T>,
@@ -141,11 +142,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ) -> Result<Self, ObserverError<T>> {
         params.check()?;
         gains.check()?;
-        if !t0.is_finite() {
-            return Err(ObserverError::InvalidTime { t: t0, last: t0 });
-        }
-        check_vector(&q0, "q0")?;
-        check_vector(&v0, "v0")?;
+        check_start(t0, &q0, &v0)?;
         Ok(Self {
             params,
             gains,
@@ -163,9 +160,9 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::NonFiniteMeasurement`] (`"q_hat0"`).
+    /// [`DataError::NonFinite`] (`"q_hat0"`).
     pub fn with_position_estimate(self, q_hat: SVector<T, N>) -> Result<Self, ObserverError<T>> {
-        check_vector(&q_hat, "q_hat0")?;
+        validate::finite_vector(&q_hat, "q_hat0")?;
         Ok(Self { q_hat, ..self })
     }
 
@@ -174,10 +171,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidRestitution`] for a coefficient outside
+    /// [`DataError::InvalidRestitution`] for a coefficient outside
     /// `[0, 1]`.
     pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, ObserverError<T>> {
-        check_restitution(&restitution)?;
+        validate::restitution(&restitution)?;
         Ok(Self {
             restitution: Some(restitution),
             ..self
@@ -262,7 +259,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
             interval.u,
         );
         report.evaluations += 1;
-        finite(&forces, "F")?;
+        finite_model(&forces, "F")?;
         let chol = factor_mass(&mass)?;
         let f2 = forces - (self.gains.l_rho1 + mass * lambda * l_d) * q_tilde;
         let z2_free = z2 - chol.solve(&f2) * tau;
@@ -372,7 +369,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for 
             Discretization::SectionVii => self.section_vii(&interval, &mut report)?,
         };
         if !(q_hat.iter().chain(v.iter()).all(|x| x.is_finite())) {
-            return Err(ObserverError::NonFiniteResult);
+            return Err(DataError::NonFiniteResult.into());
         }
         (self.t, self.q, self.q_hat, self.v, self.report) = (t, *q, q_hat, v, report);
         Ok(self.estimate())

@@ -61,6 +61,7 @@
 
 use nalgebra::{RealField, SVector};
 
+use crate::error::DataError;
 use crate::linalg::{SymmetricEigen, spectral_norm};
 use crate::model::Model;
 
@@ -112,7 +113,7 @@ impl<T: RealField + Copy, const N: usize> GainRegion<T, N> {
     }
 
     fn check(&self) -> Result<(), ObserverError<T>> {
-        let bad = |name, value| Err(ObserverError::InvalidParams { name, value });
+        let bad = |name, value| Err(super::invalid(name, value));
         for i in 0..N {
             let (lo, hi) = (self.q_min[i], self.q_max[i]);
             if !(lo.is_finite() && hi.is_finite()) {
@@ -250,11 +251,11 @@ impl<T: RealField + Copy> ModelBounds<T> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a region that is not a finite
-    /// box with `C_v > 0`, [`ObserverError::MassNotPositiveDefinite`] where
-    /// `M(q)` is not, [`ObserverError::NonFiniteModel`] where the model
-    /// evaluates to NaN, [`ObserverError::NonFiniteInput`] for a
-    /// non-finite `u`.
+    /// [`ObserverError::Data`] with [`DataError::InvalidParams`] for a
+    /// region that is not a finite box with `C_v > 0`,
+    /// [`DataError::MassNotPositiveDefinite`] where `M(q)` is not,
+    /// [`DataError::NonFiniteModel`] where the model evaluates to NaN,
+    /// [`DataError::NonFiniteInput`] for a non-finite `u`.
     pub fn estimate<M, const N: usize, const K: usize>(
         model: &M,
         region: &GainRegion<T, N>,
@@ -265,7 +266,7 @@ impl<T: RealField + Copy> ModelBounds<T> {
     {
         region.check()?;
         if let Some(index) = u.as_ref().iter().position(|x| !x.is_finite()) {
-            return Err(ObserverError::NonFiniteInput { index });
+            return Err(DataError::NonFiniteInput { index }.into());
         }
         let c_v = region.velocity_bound;
         let half: T = nalgebra::convert(0.5);
@@ -284,10 +285,10 @@ impl<T: RealField + Copy> ModelBounds<T> {
             let q = region.configuration(index);
             let mass = model.mass(&q);
             let eigen =
-                SymmetricEigen::new(&mass).ok_or(ObserverError::NonFiniteModel { which: "M" })?;
+                SymmetricEigen::new(&mass).ok_or(DataError::NonFiniteModel { which: "M" })?;
             // finite (the matrix was), so `≤ 0` is the whole test
             if eigen.min() <= T::zero() {
-                return Err(ObserverError::MassNotPositiveDefinite);
+                return Err(DataError::MassNotPositiveDefinite.into());
             }
             if first {
                 (bounds.mass_min, bounds.mass_max, first) = (eigen.min(), eigen.max(), false);
@@ -350,7 +351,7 @@ fn norm<T: RealField + Copy, const N: usize>(
     m: &nalgebra::SMatrix<T, N, N>,
     which: &'static str,
 ) -> Result<T, ObserverError<T>> {
-    spectral_norm(m).ok_or(ObserverError::NonFiniteModel { which })
+    spectral_norm(m).ok_or(DataError::NonFiniteModel { which }.into())
 }
 
 /// The first 64 primes: the Halton bases.
@@ -381,77 +382,8 @@ fn radical_inverse(mut index: u64, base: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Linearization, ModelInfo};
-    use nalgebra::{Matrix2, SMatrix, Vector2};
-
-    /// A particle of mass `m` in polar coordinates `(r, θ)`, no potential:
-    /// `M = diag(m, m r²)`, `C = m r [[0, −θ̇], [θ̇, ṙ]]`, `F = C v` and
-    /// `∂F/∂v = 2C`.
-    struct Polar {
-        m: f64,
-    }
-
-    impl Model<2, 0> for Polar {
-        type Scalar = f64;
-        type Input = SVector<f64, 0>;
-        const INFO: ModelInfo<2, 0> = ModelInfo {
-            name: "Polar",
-            coordinates: ["r", "theta"],
-            velocities: ["dr", "dtheta"],
-            constraints: [],
-            parameters: &[],
-            inputs: &[],
-            source: "",
-            op_count: 0,
-        };
-        fn mass(&self, q: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::new(self.m, 0.0, 0.0, self.m * q[0] * q[0])
-        }
-        fn coriolis(&self, q: &Vector2<f64>, v: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::new(0.0, -v[1], v[1], v[0]) * (self.m * q[0])
-        }
-        fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> {
-            Vector2::zeros()
-        }
-        fn forces(
-            &self,
-            _: f64,
-            q: &Vector2<f64>,
-            v: &Vector2<f64>,
-            _: &SVector<f64, 0>,
-        ) -> Vector2<f64> {
-            self.coriolis(q, v) * v
-        }
-        fn gaps(&self, _: &Vector2<f64>) -> SVector<f64, 0> {
-            SVector::zeros()
-        }
-        fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 0, 2> {
-            SMatrix::zeros()
-        }
-        fn restitution(&self) -> SVector<f64, 0> {
-            SVector::zeros()
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
-            None
-        }
-        fn linearization(
-            &self,
-            t: f64,
-            q: &Vector2<f64>,
-            v: &Vector2<f64>,
-            u: &SVector<f64, 0>,
-        ) -> Linearization<f64, 2> {
-            Linearization {
-                mass: self.mass(q),
-                forces: self.forces(t, q, v, u),
-                forces_dq: Matrix2::zeros(),
-                forces_dv: self.coriolis(q, v) * 2.0,
-            }
-        }
-    }
+    use crate::testing::Polar;
+    use nalgebra::Vector2;
 
     /// The sup over unit `(ṙ, θ̇)` of `‖[[0, −θ̇], [θ̇, ṙ]]‖₂`: with
     /// `y = θ̇²`, `σ² = (1 + y + √(1 + 2y − 3y²))/2`, largest at `y = 2/3`,
@@ -515,15 +447,18 @@ mod tests {
         let region = GainRegion::new(Vector2::new(1.0, 0.0), Vector2::new(0.5, 1.0), 2.0);
         assert!(matches!(
             ModelBounds::estimate(&model, &region, &u),
-            Err(ObserverError::InvalidParams { name: "q_min", .. })
+            Err(ObserverError::Data(DataError::InvalidParams {
+                name: "q_min",
+                ..
+            }))
         ));
         let region = GainRegion::new(Vector2::new(0.5, 0.0), Vector2::new(1.0, 1.0), 0.0);
         assert!(matches!(
             ModelBounds::estimate(&model, &region, &u),
-            Err(ObserverError::InvalidParams {
+            Err(ObserverError::Data(DataError::InvalidParams {
                 name: "velocity_bound",
                 ..
-            })
+            }))
         ));
         let region = GainRegion::new(Vector2::new(f64::NAN, 0.0), Vector2::new(1.0, 1.0), 1.0);
         assert!(ModelBounds::estimate(&model, &region, &u).is_err());
@@ -531,7 +466,7 @@ mod tests {
         let region = GainRegion::new(Vector2::new(0.0, 0.0), Vector2::new(1.0, 1.0), 1.0);
         assert_eq!(
             ModelBounds::estimate(&model, &region, &u),
-            Err(ObserverError::MassNotPositiveDefinite)
+            Err(ObserverError::Data(DataError::MassNotPositiveDefinite))
         );
     }
 }

@@ -243,19 +243,10 @@ pub use report::UpdateReport;
 
 use nalgebra::{RealField, SVector};
 
+use crate::error::DataError;
 use crate::model::Model;
-
-/// The estimate `(q̂, v̂)` at time `t`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Estimate<T: RealField + Copy, const N: usize> {
-    /// Time of the last measurement.
-    pub t: T,
-    /// Position estimate `q̂` (for the reduced-order observer, the
-    /// measurement `q` itself).
-    pub q: SVector<T, N>,
-    /// Velocity estimate `v̂` (a right limit: after the impacts at `t`).
-    pub v: SVector<T, N>,
-}
+use crate::state::Estimate;
+use crate::validate;
 
 /// The paper's class of estimators (13)–(15): driven by measured positions
 /// `q(t_k)`, known inputs and time, never by the velocity.
@@ -359,41 +350,27 @@ where
     if !(t.is_finite() && tau > T::zero() && tau.is_finite()) {
         return Err(ObserverError::InvalidTime { t, last });
     }
-    if let Some(index) = q.iter().position(|x| !x.is_finite()) {
-        return Err(ObserverError::NonFiniteMeasurement { which: "q", index });
-    }
-    if let Some(index) = u.as_ref().iter().position(|x| !x.is_finite()) {
-        return Err(ObserverError::NonFiniteInput { index });
-    }
-    let mut index = 0;
-    while let Some(p) = model.parameter(index) {
-        if !p.is_finite() {
-            return Err(ObserverError::NonFiniteParameter { index });
-        }
-        index += 1;
-    }
+    validate::finite_vector(q, "q")?;
+    validate::model_and_input(model, u)?;
     Ok(tau)
 }
 
-/// Checks initial data.
-pub(crate) fn check_vector<T: RealField + Copy, const N: usize>(
-    x: &SVector<T, N>,
-    which: &'static str,
+/// Checks an observer's initial data: a finite start time `t0`, finite
+/// `q0` and `v0`.
+pub(crate) fn check_start<T: RealField + Copy, const N: usize>(
+    t0: T,
+    q0: &SVector<T, N>,
+    v0: &SVector<T, N>,
 ) -> Result<(), ObserverError<T>> {
-    match x.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(ObserverError::NonFiniteMeasurement { which, index }),
-        None => Ok(()),
+    if !t0.is_finite() {
+        return Err(ObserverError::InvalidTime { t: t0, last: t0 });
     }
+    validate::finite_vector(q0, "q0")?;
+    validate::finite_vector(v0, "v0")?;
+    Ok(())
 }
 
-/// Checks restitution coefficients are in `[0, 1]`.
-pub(crate) fn check_restitution<T: RealField + Copy, const K: usize>(
-    e: &SVector<T, K>,
-) -> Result<(), ObserverError<T>> {
-    for (constraint, &value) in e.iter().enumerate() {
-        if !(value >= T::zero() && value <= T::one()) {
-            return Err(ObserverError::InvalidRestitution { constraint, value });
-        }
-    }
-    Ok(())
+/// An invalid setting, as an [`ObserverError`].
+pub(crate) fn invalid<T>(name: &'static str, value: T) -> ObserverError<T> {
+    ObserverError::Data(DataError::InvalidParams { name, value })
 }

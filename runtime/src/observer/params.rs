@@ -119,7 +119,7 @@ impl<T: RealField + Copy> ObserverParams<T> {
     /// finite.
     pub(crate) fn check(&self) -> Result<(), super::ObserverError<T>> {
         let zero = T::zero();
-        let bad = |name, value| Err(super::ObserverError::InvalidParams { name, value });
+        let bad = |name, value| Err(super::invalid(name, value));
         let positive = [("l_d", self.l_d), ("velocity_bound", self.velocity_bound)];
         for (name, value) in positive {
             if !(value > zero && value.is_finite()) {

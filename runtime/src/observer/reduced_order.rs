@@ -6,11 +6,12 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Interval, Memory, factor_mass, finite, saturate};
+use super::interval::{Interval, Memory, saturate};
 use super::{
-    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
-    check_restitution, check_vector,
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport, check_start,
 };
+use crate::error::DataError;
+use crate::validate::{self, factor_mass, finite_model};
 
 /// The reduced-order velocity observer (38): `q̂ = q`, and
 ///
@@ -81,8 +82,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a setting out of its range,
-    /// [`ObserverError::NonFiniteMeasurement`] (`"q0"`, `"v0"`) or
+    /// [`DataError::InvalidParams`] for a setting out of its range,
+    /// [`DataError::NonFinite`] (`"q0"`, `"v0"`) or
     /// [`ObserverError::InvalidTime`] for non-finite initial data.
     pub fn new(
         params: ObserverParams<T>,
@@ -91,11 +92,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         v0: SVector<T, N>,
     ) -> Result<Self, ObserverError<T>> {
         params.check()?;
-        if !t0.is_finite() {
-            return Err(ObserverError::InvalidTime { t: t0, last: t0 });
-        }
-        check_vector(&q0, "q0")?;
-        check_vector(&v0, "v0")?;
+        check_start(t0, &q0, &v0)?;
         Ok(Self {
             params,
             restitution: None,
@@ -112,10 +109,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidRestitution`] for a coefficient outside
+    /// [`DataError::InvalidRestitution`] for a coefficient outside
     /// `[0, 1]`.
     pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, ObserverError<T>> {
-        check_restitution(&restitution)?;
+        validate::restitution(&restitution)?;
         Ok(Self {
             restitution: Some(restitution),
             ..self
@@ -153,7 +150,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
             interval.u,
         );
         report.evaluations += 1;
-        finite(&forces, "F")?;
+        finite_model(&forces, "F")?;
         let chol = factor_mass(&mass)?;
         let v_free = v_pre - chol.solve(&forces) * tau - v_pre * (tau * l_d);
         report.innovation = q1 - self.q - self.v * tau;
@@ -237,7 +234,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
         };
         // WRITEBACK: only a finite estimate replaces the state
         if !v.iter().all(|x| x.is_finite()) {
-            return Err(ObserverError::NonFiniteResult);
+            return Err(DataError::NonFiniteResult.into());
         }
         (self.t, self.q, self.v, self.report) = (t, *q, v, report);
         Ok(self.estimate())
@@ -263,63 +260,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ModelInfo;
-    use nalgebra::{Matrix1, Matrix2, SMatrix, Vector1, Vector2};
-
-    /// A ball of unit mass above the floor `y ≥ 0`, gravity `g`,
-    /// restitution `e`.
-    struct Ball {
-        g: f64,
-        e: f64,
-    }
-
-    impl Model<1, 1> for Ball {
-        type Scalar = f64;
-        type Input = SVector<f64, 0>;
-        const INFO: ModelInfo<1, 1> = ModelInfo {
-            name: "Ball",
-            coordinates: ["y"],
-            velocities: ["vy"],
-            constraints: ["floor"],
-            parameters: &[],
-            inputs: &[],
-            source: "",
-            op_count: 0,
-        };
-        fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> {
-            Matrix1::new(1.0)
-        }
-        fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> {
-            Matrix1::zeros()
-        }
-        fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> {
-            Vector1::new(self.g)
-        }
-        fn forces(
-            &self,
-            _: f64,
-            q: &Vector1<f64>,
-            _: &Vector1<f64>,
-            _: &SVector<f64, 0>,
-        ) -> Vector1<f64> {
-            self.gravity(q)
-        }
-        fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> {
-            *q
-        }
-        fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> {
-            Matrix1::new(1.0)
-        }
-        fn restitution(&self) -> Vector1<f64> {
-            Vector1::new(self.e)
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
-            None
-        }
-    }
+    use crate::testing::{Ball, Puck};
+    use nalgebra::{Vector1, Vector2};
 
     /// The exact bouncing ball dropped from rest at `y0`: `(y, v)` at `t`
     /// (right limits), and the impact times.
@@ -452,60 +394,6 @@ mod tests {
         assert!(rms < 3.0 * 10.0 * sigma, "{rms}");
     }
 
-    /// A puck of unit mass on the floor `y ≥ 0`, pressed by gravity and
-    /// pushed along by a constant force `f`.
-    struct Puck {
-        f: f64,
-    }
-
-    impl Model<2, 1> for Puck {
-        type Scalar = f64;
-        type Input = SVector<f64, 0>;
-        const INFO: ModelInfo<2, 1> = ModelInfo {
-            name: "Puck",
-            coordinates: ["x", "y"],
-            velocities: ["vx", "vy"],
-            constraints: ["floor"],
-            parameters: &[],
-            inputs: &[],
-            source: "",
-            op_count: 0,
-        };
-        fn mass(&self, _: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::identity()
-        }
-        fn coriolis(&self, _: &Vector2<f64>, _: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::zeros()
-        }
-        fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> {
-            Vector2::new(0.0, 9.81)
-        }
-        fn forces(
-            &self,
-            _: f64,
-            q: &Vector2<f64>,
-            _: &Vector2<f64>,
-            _: &SVector<f64, 0>,
-        ) -> Vector2<f64> {
-            self.gravity(q) - Vector2::new(self.f, 0.0)
-        }
-        fn gaps(&self, q: &Vector2<f64>) -> Vector1<f64> {
-            Vector1::new(q[1])
-        }
-        fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 1, 2> {
-            SMatrix::<f64, 1, 2>::new(0.0, 1.0)
-        }
-        fn restitution(&self) -> Vector1<f64> {
-            Vector1::new(0.9)
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
-            None
-        }
-    }
-
     /// Sliding: the contact force cancels the normal part of gravity, the
     /// estimate stays tangent, and the tangential error decays exactly like
     /// `e^{−l_d t}` (the contact does not disturb the injection).
@@ -532,45 +420,10 @@ mod tests {
     /// The observer is generic in the scalar: `f32` runs the same bounce.
     #[test]
     fn runs_in_f32() {
-        struct Ball32;
-        impl Model<1, 1> for Ball32 {
-            type Scalar = f32;
-            type Input = SVector<f32, 0>;
-            const INFO: ModelInfo<1, 1> = Ball::INFO;
-            fn mass(&self, _: &Vector1<f32>) -> Matrix1<f32> {
-                Matrix1::new(1.0)
-            }
-            fn coriolis(&self, _: &Vector1<f32>, _: &Vector1<f32>) -> Matrix1<f32> {
-                Matrix1::zeros()
-            }
-            fn gravity(&self, _: &Vector1<f32>) -> Vector1<f32> {
-                Vector1::new(9.81)
-            }
-            fn forces(
-                &self,
-                _: f32,
-                q: &Vector1<f32>,
-                _: &Vector1<f32>,
-                _: &SVector<f32, 0>,
-            ) -> Vector1<f32> {
-                self.gravity(q)
-            }
-            fn gaps(&self, q: &Vector1<f32>) -> Vector1<f32> {
-                *q
-            }
-            fn gap_jacobian(&self, _: &Vector1<f32>) -> Matrix1<f32> {
-                Matrix1::new(1.0)
-            }
-            fn restitution(&self) -> Vector1<f32> {
-                Vector1::new(0.8)
-            }
-            fn parameter(&self, _: usize) -> Option<f32> {
-                None
-            }
-            fn parameter_mut(&mut self, _: usize) -> Option<&mut f32> {
-                None
-            }
-        }
+        let ball = Ball {
+            g: 9.81_f32,
+            e: 0.8,
+        };
         let params = ObserverParams::new(10.0_f32, 20.0);
         let mut observer =
             ReducedOrder::<f32, 1, 1>::new(params, 0.0, Vector1::new(1.0), Vector1::zeros())
@@ -580,12 +433,7 @@ mod tests {
             let t = k as f64 * 1e-3;
             let (y, v, _) = exact_ball(9.81, 0.8, 1.0, t);
             let estimate = observer
-                .update(
-                    &Ball32,
-                    t as f32,
-                    &Vector1::new(y as f32),
-                    &SVector::zeros(),
-                )
+                .update(&ball, t as f32, &Vector1::new(y as f32), &SVector::zeros())
                 .unwrap();
             worst = worst.max((estimate.v[0] - v as f32).abs());
         }
