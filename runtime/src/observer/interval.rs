@@ -105,27 +105,27 @@ impl<T: RealField + Copy, const N: usize> Segment<T, N> {
 
 /// How each constraint stands at the start of a piece of motion.
 #[derive(Clone, Copy, Default)]
-struct Classes {
+struct Classes<const K: usize> {
     /// Open (`h_i` above the band): watched for a crossing.
-    free: IndexSet,
+    free: IndexSet<K>,
     /// Closed (within the band, or just reached).
-    contact: IndexSet,
+    contact: IndexSet<K>,
     /// Closed and approaching: Newton's law now.
-    approaching: IndexSet,
+    approaching: IndexSet<K>,
     /// Approaching faster than the resting speed: `ê_i` applies.
-    elastic: IndexSet,
+    elastic: IndexSet<K>,
     /// Closed, normal speed within the resting speed: persistent contact.
-    sliding: IndexSet,
+    sliding: IndexSet<K>,
     /// Closed and separating: watched for a return.
-    departing: IndexSet,
+    departing: IndexSet<K>,
 }
 
 /// What the search along a piece of motion found first: these
 /// constraints close (or, for a departing one that never opened, turn
 /// back) at `at`, relative to the piece's start.
-struct Crossing<T> {
+struct Crossing<T, const K: usize> {
     at: T,
-    set: IndexSet,
+    set: IndexSet<K>,
 }
 
 /// One sampling interval: the model, the two measurements around it and
@@ -220,8 +220,8 @@ where
     fn newton(
         &self,
         at: &Contact<'_, T, N, K>,
-        set: IndexSet,
-        elastic: IndexSet,
+        set: IndexSet<K>,
+        elastic: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<SVector<T, N>, T> {
         let Contact { s, w, jac, chol } = *at;
@@ -253,7 +253,7 @@ where
         chol: &Cholesky<T, N>,
         w_free: &SVector<T, N>,
         approach: &SVector<T, K>,
-        set: IndexSet,
+        set: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<SVector<T, N>, T> {
         if set.is_empty() {
@@ -329,7 +329,7 @@ where
         &self,
         p: &SVector<T, N>,
         w: &SVector<T, N>,
-        sliding: IndexSet,
+        sliding: IndexSet<K>,
         free: &Free<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, K>), T> {
@@ -359,7 +359,7 @@ where
         &self,
         start: &Point<'_, T, N>,
         h: T,
-        sliding: IndexSet,
+        sliding: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Arc<T, N, K>, T> {
         let Point {
@@ -422,17 +422,17 @@ where
         &self,
         at: &Point<'_, T, N>,
         (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
-        resolved: IndexSet,
-        touched: IndexSet,
-    ) -> Result<Classes, T> {
+        resolved: IndexSet<K>,
+        touched: IndexSet<K>,
+    ) -> Result<Classes<K>, T> {
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
         let mut c = Classes::default();
         let band = self.params.contact_band();
         let noise_speed = self.noise_speed();
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
         let four: T = nalgebra::convert(4.0);
-        let mut closed = IndexSet::EMPTY;
-        for i in 0..K.min(IndexSet::CAPACITY) {
+        let mut closed = IndexSet::<K>::EMPTY;
+        for i in 0..K {
             let g = jac.row(i).norm();
             if h[i] <= g * band || touched.contains(i) {
                 closed.insert(i);
@@ -556,15 +556,15 @@ where
     fn first_crossing(
         &self,
         seg: &Segment<T, N>,
-        c: &Classes,
+        c: &Classes<K>,
         bands: &SVector<T, K>,
         start: (&SVector<T, K>, &SVector<T, K>),
         end: (&SVector<T, K>, &SVector<T, K>),
-    ) -> Result<Option<Crossing<T>>, T> {
+    ) -> Result<Option<Crossing<T, K>>, T> {
         let (h0, rate0) = start;
         let (h1, rate1) = end;
         let zero = T::zero();
-        let mut best: Option<(T, IndexSet)> = None;
+        let mut best: Option<(T, IndexSet<K>)> = None;
         let tol = T::default_epsilon() * nalgebra::convert(1024.0) * self.tau;
         let mut record = |at: T, i: usize| match &mut best {
             Some((s, set)) if (at - *s).abs() <= tol => {
@@ -699,7 +699,7 @@ where
         let (h, jac) = self.contact(&self.q1)?;
         let band = self.params.contact_band();
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * v.norm();
-        let approaching = (0..K.min(IndexSet::CAPACITY)).any(|i| {
+        let approaching = (0..K).any(|i| {
             let row = jac.row(i);
             h[i] <= row.norm() * band && row.dot(&v.transpose()) < -roundoff * row.norm()
         });

@@ -24,12 +24,12 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     /// Time of the first impact in the interval, if any.
     pub first_impact: Option<T>,
     /// Constraints that received an impulse at an impact.
-    pub impacted: IndexSet,
+    pub impacted: IndexSet<K>,
     /// Constraints treated as persistent contacts during the interval (the
     /// mass sliding along them).
-    pub contacts: IndexSet,
+    pub contacts: IndexSet<K>,
     /// Every constraint that took part in a complementarity problem.
-    pub active: IndexSet,
+    pub active: IndexSet<K>,
     /// Sum over the interval of the multipliers per constraint: impulses `λ`
     /// of the impacts plus the integral `∫ λ dt` of the contact forces
     /// (momentum units, as `Jᵀλ`).

@@ -380,7 +380,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
         jac: &SMatrix<T, K, N>,
         v_free: &SVector<T, N>,
         restitution_term: &SVector<T, K>,
-        active: IndexSet,
+        active: IndexSet<K>,
     ) -> Result<Impulse<T, N, K>, StepError<T>> {
         if active.is_empty() {
             return Ok(Impulse::none());
@@ -413,7 +413,7 @@ struct Start<T: RealField + Copy, const N: usize, const K: usize> {
     forces: SVector<T, N>,
     restitution: SVector<T, K>,
     /// The index set of the step.
-    active: IndexSet,
+    active: IndexSet<K>,
 }
 
 /// The outcome of one Newton iteration.
@@ -461,9 +461,9 @@ pub fn predict_index_set<T: RealField + Copy, const K: usize>(
     gaps: &SVector<T, K>,
     normal_velocity: &SVector<T, K>,
     gamma_tau: T,
-) -> IndexSet {
+) -> IndexSet<K> {
     let mut set = IndexSet::new();
-    for i in 0..K.min(IndexSet::CAPACITY) {
+    for i in 0..K {
         if gaps[i] + gamma_tau * normal_velocity[i] <= T::zero() {
             set.insert(i);
         }
