@@ -25,7 +25,7 @@ pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, 
 pub use model::{Linearization, Model, ModelInfo, Terms};
 pub use observer::{
     Design, Discretization, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
-    ObserverError, ObserverParams, ReducedOrder, UpdateReport,
+    ObserverError, ObserverParams, ReducedOrder, Restart, UpdateReport,
 };
 pub use state::{Estimate, State};
 pub use stepper::{

@@ -26,6 +26,19 @@ pub enum ObserverError<T> {
         /// The time of the last measurement.
         last: T,
     },
+    /// The measurement is farther from the last accepted one than the
+    /// system can move in the interval
+    /// ([`ObserverParams::outlier_bound`](crate::ObserverParams::outlier_bound)):
+    /// skipped, the estimate kept. The observer counts it (the next
+    /// accepted update reports the count), and after
+    /// [`max_outliers`](crate::ObserverParams::max_outliers) in a row it
+    /// restarts from the measurement instead.
+    Outlier {
+        /// `|q − q_k|`.
+        distance: T,
+        /// The bound it exceeds.
+        bound: T,
+    },
 }
 
 impl<T> From<DataError<T>> for ObserverError<T> {
@@ -47,6 +60,10 @@ impl<T: fmt::Display> fmt::Display for ObserverError<T> {
             Self::InvalidTime { t, last } => write!(
                 f,
                 "measurement time {t} is not finite or not after the last one, {last}"
+            ),
+            Self::Outlier { distance, bound } => write!(
+                f,
+                "outlier: the measurement is {distance} from the last accepted one, more than the system moves ({bound})"
             ),
         }
     }

@@ -7,11 +7,11 @@ use crate::linalg::SymmetricEigen;
 use crate::model::Model;
 
 use super::interval::{Interval, Memory, saturate};
-use super::reduced_order::section_vii_impact;
+use super::reduced_order::{restart_velocity, section_vii_impact};
 use super::{
-    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport, check_start,
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
+    UpdateReport, check_start,
 };
-use crate::error::DataError;
 use crate::validate::{self, factor_mass, finite_model};
 
 /// The gains `Λ` and `L_ρ1` of the full-order observer (36), both
@@ -118,6 +118,8 @@ pub struct FullOrder<T: RealField + Copy, const N: usize, const K: usize> {
     q_hat: SVector<T, N>,
     v: SVector<T, N>,
     report: UpdateReport<T, N, K>,
+    /// The outliers refused since the last accepted measurement.
+    outliers: Outliers<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
@@ -128,10 +130,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`DataError::InvalidParams`] for a setting out of its range or a
+    /// [`DataError::InvalidParams`](crate::DataError::InvalidParams) for a setting out of its range or a
     /// gain matrix that is not symmetric positive definite (`"lambda"`,
     /// `"l_rho1"`, with the offending eigenvalue),
-    /// [`DataError::NonFinite`] or
+    /// [`DataError::NonFinite`](crate::DataError::NonFinite) or
     /// [`ObserverError::InvalidTime`] for non-finite initial data.
     pub fn new(
         params: ObserverParams<T>,
@@ -153,6 +155,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
             q_hat: q0,
             v: v0,
             report: UpdateReport::new(t0, T::zero()),
+            outliers: Outliers::NONE,
         })
     }
 
@@ -160,7 +163,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`DataError::NonFinite`] (`"q_hat0"`).
+    /// [`DataError::NonFinite`](crate::DataError::NonFinite) (`"q_hat0"`).
     pub fn with_position_estimate(self, q_hat: SVector<T, N>) -> Result<Self, ObserverError<T>> {
         validate::finite_vector(&q_hat, "q_hat0")?;
         Ok(Self { q_hat, ..self })
@@ -171,7 +174,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`DataError::InvalidRestitution`] for a coefficient outside
+    /// [`DataError::InvalidRestitution`](crate::DataError::InvalidRestitution) for a coefficient outside
     /// `[0, 1]`.
     pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, ObserverError<T>> {
         validate::restitution(&restitution)?;
@@ -214,7 +217,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         M: Model<N, K, Scalar = T>,
     {
         let tau = interval.tau;
-        let (p_end, w_end) = interval.predict(&self.v, report)?;
+        let v0 = saturate(&self.v, self.params.velocity_bound);
+        let (p_end, w_end) = interval.predict(&v0, report)?;
         let innovation = interval.q1 - p_end;
         report.innovation = innovation;
         // the errors the samples reveal: q̃_k, and ṽ_k = ∫ṽ/τ = d/τ
@@ -267,6 +271,31 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         report.innovation = q1 - self.q - self.v * tau;
         let v = section_vii_impact(interval, &chol, &self.v, &v_free, report)?;
         Ok((z1_next, v))
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
+    /// The interval integrated by the chosen discretization, from `v̂_k`
+    /// held to `C_v`; `Err` names a restart when that failed from the
+    /// observer's own state.
+    fn integrate<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<(SVector<T, N>, SVector<T, N>), Restart>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let result = match self.params.scheme {
+            Discretization::ImpactAware => self.impact_aware(interval, report),
+            Discretization::SectionVii => self.section_vii(interval, report),
+        };
+        match result {
+            Ok((q_hat, v)) if q_hat.iter().chain(v.iter()).all(|x| x.is_finite()) => Ok((q_hat, v)),
+            // a failure from the observer's own state, or (no other error
+            // arises past the checks of `begin`) anything else
+            Ok(_) | Err(_) => Err(Restart::Infeasible),
+        }
     }
 }
 
@@ -363,14 +392,27 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for 
             restitution: self.restitution,
             report: &self.report,
         };
-        let (interval, mut report) = Interval::begin(model, u, memory, t, q)?;
-        let (q_hat, v) = match self.params.scheme {
-            Discretization::ImpactAware => self.impact_aware(&interval, &mut report)?,
-            Discretization::SectionVii => self.section_vii(&interval, &mut report)?,
+        let (interval, fresh) = Interval::begin(model, u, memory, t, q)?;
+        // SCREEN: an outlier is refused here, the estimate untouched
+        let plan = self
+            .outliers
+            .screen(&self.params, (t, interval.tau), &self.q, q)?;
+        let mut report = fresh;
+        let integrated = match plan {
+            Plan::Integrate => self.integrate(&interval, &mut report),
+            Plan::Restart(why) => Err(why),
         };
-        if !(q_hat.iter().chain(v.iter()).all(|x| x.is_finite())) {
-            return Err(DataError::NonFiniteResult.into());
-        }
+        let (q_hat, v) = match integrated {
+            Ok(estimate) => estimate,
+            Err(why) => {
+                report = fresh;
+                let v = restart_velocity(&interval, &self.v, why, &mut report)?;
+                (*q, v)
+            }
+        };
+        // WRITEBACK: the velocity estimate held to C_v, as in ReducedOrder
+        let v = saturate(&v, self.params.velocity_bound);
+        report.outliers = self.outliers.accept();
         (self.t, self.q, self.q_hat, self.v, self.report) = (t, *q, q_hat, v, report);
         Ok(self.estimate())
     }

@@ -8,7 +8,8 @@ use crate::model::Model;
 
 use super::interval::{Interval, Memory, saturate};
 use super::{
-    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport, check_start,
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
+    UpdateReport, check_start,
 };
 use crate::error::DataError;
 use crate::validate::{self, factor_mass, finite_model};
@@ -74,6 +75,8 @@ pub struct ReducedOrder<T: RealField + Copy, const N: usize, const K: usize> {
     q: SVector<T, N>,
     v: SVector<T, N>,
     report: UpdateReport<T, N, K>,
+    /// The outliers refused since the last accepted measurement.
+    outliers: Outliers<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
@@ -101,6 +104,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
             q: q0,
             v: v0,
             report: UpdateReport::new(t0, T::zero()),
+            outliers: Outliers::NONE,
         })
     }
 
@@ -155,6 +159,89 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         let v_free = v_pre - chol.solve(&forces) * tau - v_pre * (tau * l_d);
         report.innovation = q1 - self.q - self.v * tau;
         section_vii_impact(interval, &chol, &self.v, &v_free, report)
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
+    /// The interval integrated by the chosen discretization, from `v̂_k`
+    /// held to `C_v`; `Err` names a restart when that failed from the
+    /// observer's own state.
+    fn integrate<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, Restart>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let v0 = saturate(&self.v, self.params.velocity_bound);
+        let result = match self.params.scheme {
+            Discretization::ImpactAware => (|| {
+                // PREDICT from (q_k, v̂_k), impacts inside the interval
+                let (p_end, w_end) = interval.predict(&v0, report)?;
+                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
+                // displacement, integrated exactly over τ
+                let innovation = interval.q1 - p_end;
+                report.innovation = innovation;
+                let v = w_end + innovation * interval.gain;
+                // CLOSE: v̂_e ∈ V(q_{k+1})
+                interval.close_at_end(&v, report)
+            })(),
+            Discretization::SectionVii => self.section_vii(interval, report),
+        };
+        match result {
+            Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(v),
+            // a failure from the observer's own state, or (no other error
+            // arises past the checks of `begin`) anything else
+            Ok(_) | Err(_) => Err(Restart::Infeasible),
+        }
+    }
+
+    /// The estimate restarted from the measurement `q_{k+1}`: `v̂_k` kept
+    /// after outliers, else the mean velocity over the interval, held to
+    /// `C_v`, then Newton's law at `q_{k+1}` for the closed constraints it
+    /// approaches.
+    fn restart<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        why: Restart,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, ObserverError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        restart_velocity(interval, &self.v, why, report)
+    }
+}
+
+/// The velocity a restart starts from (see [`Restart`]), closed at the
+/// measurement; the report records the restart and, as its innovation, the
+/// displacement the old estimate did not explain (so the next update
+/// treats the estimate as uncertain).
+pub(crate) fn restart_velocity<M, T, const N: usize, const K: usize>(
+    interval: &Interval<'_, M, T, N, K>,
+    v_k: &SVector<T, N>,
+    why: Restart,
+    report: &mut UpdateReport<T, N, K>,
+) -> Result<SVector<T, N>, ObserverError<T>>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    let bound = interval.params.velocity_bound;
+    let displacement = interval.q1 - interval.q0;
+    let v = match why {
+        Restart::Outliers => *v_k,
+        Restart::LongInterval | Restart::Infeasible => displacement / interval.tau,
+    };
+    let v = saturate(&v, bound);
+    report.restart = Some(why);
+    report.innovation = displacement - saturate(v_k, bound) * interval.tau;
+    let v = interval.close_at_end(&v, report)?;
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(DataError::NonFiniteResult.into())
     }
 }
 
@@ -217,25 +304,27 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
             restitution: self.restitution,
             report: &self.report,
         };
-        let (interval, mut report) = Interval::begin(model, u, memory, t, q)?;
-        let v = match self.params.scheme {
-            Discretization::ImpactAware => {
-                // PREDICT from (q_k, v̂_k), impacts inside the interval
-                let (p_end, w_end) = interval.predict(&self.v, &mut report)?;
-                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
-                // displacement, integrated exactly over τ
-                let innovation = q - p_end;
-                report.innovation = innovation;
-                let v = w_end + innovation * interval.gain;
-                // CLOSE: v̂_e ∈ V(q_{k+1})
-                interval.close_at_end(&v, &mut report)?
-            }
-            Discretization::SectionVii => self.section_vii(&interval, &mut report)?,
+        let (interval, fresh) = Interval::begin(model, u, memory, t, q)?;
+        // SCREEN: an outlier is refused here, the estimate untouched
+        let plan = self
+            .outliers
+            .screen(&self.params, (t, interval.tau), &self.q, q)?;
+        let mut report = fresh;
+        let integrated = match plan {
+            Plan::Integrate => self.integrate(&interval, &mut report),
+            Plan::Restart(why) => Err(why),
         };
-        // WRITEBACK: only a finite estimate replaces the state
-        if !v.iter().all(|x| x.is_finite()) {
-            return Err(DataError::NonFiniteResult.into());
-        }
+        let v = match integrated {
+            Ok(v) => v,
+            Err(why) => {
+                report = fresh;
+                self.restart(&interval, why, &mut report)?
+            }
+        };
+        // WRITEBACK: the estimate held to C_v (a radial projection onto a
+        // ball that holds the true velocity never moves it away from it)
+        let v = saturate(&v, self.params.velocity_bound);
+        report.outliers = self.outliers.accept();
         (self.t, self.q, self.v, self.report) = (t, *q, v, report);
         Ok(self.estimate())
     }
