@@ -633,7 +633,7 @@ fn smooth_decay_is_at_least_the_guaranteed_rate() {
             .all(|s| pendulum.gaps(&s.q).min() > 1e-3)
     );
     let bounds = bounds_along(&pendulum, &data, 0.45, &zero);
-    let l_d = bounds.gain(Design::ReducedOrder, 1.0).ceil();
+    let l_d = bounds.gain_for_margin(Design::ReducedOrder, 1.0).ceil();
     let v_hat0 = Vector2::new(1.0, -1.0);
     decays_at_the_guaranteed_rate("double pendulum", &pendulum, &data, &bounds, l_d, v_hat0);
 }
@@ -661,10 +661,10 @@ fn decays_at_the_guaranteed_rate<M>(
         bounds.coriolis,
         bounds.force_lipschitz,
         bounds.velocity_bound,
-        bounds.beta(Design::FullOrder, l_d),
-        bounds.beta(Design::ReducedOrder, l_d),
+        bounds.margin(Design::FullOrder, l_d),
+        bounds.margin(Design::ReducedOrder, l_d),
     );
-    assert!(rate >= bounds.beta(Design::ReducedOrder, l_d) - 1e-12);
+    assert!(rate >= bounds.margin(Design::ReducedOrder, l_d) - 1e-12);
     let params = ObserverParams::new(l_d, bounds.velocity_bound);
     let measured = measure(data, 0.0, 0);
 

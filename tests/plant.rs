@@ -53,8 +53,7 @@ where
 {
     let reference = siconos::<N>(stem);
     let model = M::default();
-    let mut params = StepParams::new(1e-3);
-    params.approach_velocity = approach;
+    let params = StepParams::new(1e-3).with_approach_velocity(approach);
     let stepper = MoreauJean::new(params).unwrap();
     let u = SVector::zeros();
     let mut worst_step = (0.0_f64, 0);
@@ -156,8 +155,7 @@ fn siconos_law_gains_energy_on_a_dispersing_billiard() {
         restitution: Vector4::repeat(1.0),
         ..Default::default()
     };
-    let mut params = StepParams::new(1e-3);
-    params.approach_velocity = ApproachVelocity::Start;
+    let params = StepParams::siconos(1e-3);
     let stepper = MoreauJean::new(params).unwrap();
     let mut state = State::new(0.0, Vector2::new(0.05, 0.1), Vector2::new(1.5, 0.7));
     let e0 = 0.5 * state.v.norm_squared();

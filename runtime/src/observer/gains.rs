@@ -220,10 +220,13 @@ impl<T: RealField + Copy, const N: usize> GainRegion<T, N> {
 /// let region = GainRegion::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0), 5.0);
 /// let bounds = ModelBounds::estimate(&Puck { m: 2.0, b: 0.5 }, &region, &SVector::zeros())?;
 /// assert_eq!((bounds.mass_min, bounds.coriolis, bounds.force_lipschitz), (2.0, 0.0, 0.5));
-/// // Corollary 3 for β = 10: 2 l_d ≥ 2·0.5 + 10
-/// assert_eq!(bounds.gain(Design::ReducedOrder, 10.0), 5.5);
+/// // the gain for Corollary 3 with margin β = 10 kg/s: 2 l_d ≥ 2·0.5 + 10
+/// let l_d = bounds.gain_for_margin(Design::ReducedOrder, 10.0);
+/// assert_eq!(l_d, 5.5);
 /// // the velocity error of l_d = 5.5 decays at least like e^{-(5.5 - 0.5/2) t}
-/// assert_eq!(bounds.decay_rate(5.5), 5.25);
+/// assert_eq!(bounds.decay_rate(l_d), 5.25);
+/// // and the other way: the gain for a decay rate of 5.25 /s
+/// assert_eq!(bounds.gain_for_decay_rate(5.25), 5.5);
 /// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -313,18 +316,27 @@ impl<T: RealField + Copy> ModelBounds<T> {
         Ok(bounds)
     }
 
-    /// The `l_d` at which `design`'s corollary holds with equality for the
-    /// margin `β`: `(C_F + C_M C_v + β)/λ_min` (Corollary 2; its strict
-    /// inequality holds for any larger `l_d`) or
-    /// `(2 C_v C_M + 2 C_F + β)/λ_min` (Corollary 3).
-    pub fn gain(&self, design: Design, beta: T) -> T {
+    /// The gain `l_d` (1/s) at which `design`'s corollary holds with
+    /// equality for the margin `β` (in the units of `M` per second, kg/s for
+    /// a mass; not a rate): `(C_F + C_M C_v + β)/λ_min` (Corollary 2; its
+    /// strict inequality holds for any larger `l_d`) or
+    /// `(2 C_v C_M + 2 C_F + β)/λ_min` (Corollary 3). For a decay rate, see
+    /// [`gain_for_decay_rate`](Self::gain_for_decay_rate).
+    pub fn gain_for_margin(&self, design: Design, beta: T) -> T {
         (self.coupling(design) + beta) / self.mass_min
     }
 
+    /// The gain `l_d` (1/s) whose guaranteed decay rate
+    /// ([`decay_rate`](Self::decay_rate)) is `rate` (1/s):
+    /// `rate + (C_F + C_M C_v)/λ_min`.
+    pub fn gain_for_decay_rate(&self, rate: T) -> T {
+        rate + self.coupling(Design::FullOrder) / self.mass_min
+    }
+
     /// The margin `β = λ_min l_d − (C_F + C_M C_v)` (Corollary 2) or
-    /// `λ_min l_d − 2 (C_v C_M + C_F)` (Corollary 3) that `l_d` leaves;
-    /// negative when `l_d` is too small for the corollary.
-    pub fn beta(&self, design: Design, l_d: T) -> T {
+    /// `λ_min l_d − 2 (C_v C_M + C_F)` (Corollary 3) that the gain `l_d`
+    /// leaves; negative when `l_d` is too small for the corollary.
+    pub fn margin(&self, design: Design, l_d: T) -> T {
         self.mass_min * l_d - self.coupling(design)
     }
 
@@ -410,10 +422,10 @@ mod tests {
         assert!(b.force_lipschitz >= c_f * (1.0 - 1e-3));
         assert_eq!(b.configurations, 4 + 1 + 512);
         // the corollaries, both ways
-        let l_d = b.gain(Design::ReducedOrder, 1.0);
-        assert!((b.beta(Design::ReducedOrder, l_d) - 1.0).abs() < 1e-12);
-        let l_d = b.gain(Design::FullOrder, 1.0);
-        assert!((b.beta(Design::FullOrder, l_d) - 1.0).abs() < 1e-12);
+        let l_d = b.gain_for_margin(Design::ReducedOrder, 1.0);
+        assert!((b.margin(Design::ReducedOrder, l_d) - 1.0).abs() < 1e-12);
+        let l_d = b.gain_for_margin(Design::FullOrder, 1.0);
+        assert!((b.margin(Design::FullOrder, l_d) - 1.0).abs() < 1e-12);
         // r = β₂ / λ_min
         assert!((b.decay_rate(l_d) - 1.0 / b.mass_min).abs() < 1e-12);
     }

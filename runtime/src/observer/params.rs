@@ -133,6 +133,92 @@ impl<T: RealField + Copy> ObserverParams<T> {
         Self { scheme, ..self }
     }
 
+    /// The same settings with the injection gain `l_d` (see
+    /// [`l_d`](Self::l_d); `max_interval` is left as it was).
+    #[must_use]
+    pub fn with_l_d(self, l_d: T) -> Self {
+        Self { l_d, ..self }
+    }
+
+    /// The same settings with the velocity bound `C_v` (see
+    /// [`velocity_bound`](Self::velocity_bound)).
+    #[must_use]
+    pub fn with_velocity_bound(self, velocity_bound: T) -> Self {
+        Self {
+            velocity_bound,
+            ..self
+        }
+    }
+
+    /// The same settings with `n_σ` (see [`noise_sigmas`](Self::noise_sigmas)).
+    #[must_use]
+    pub fn with_noise_sigmas(self, noise_sigmas: T) -> Self {
+        Self {
+            noise_sigmas,
+            ..self
+        }
+    }
+
+    /// The same settings with this contact distance (see
+    /// [`contact_distance`](Self::contact_distance)).
+    #[must_use]
+    pub fn with_contact_distance(self, contact_distance: T) -> Self {
+        Self {
+            contact_distance,
+            ..self
+        }
+    }
+
+    /// The same settings with this resting-speed factor (see
+    /// [`rest_factor`](Self::rest_factor)).
+    #[must_use]
+    pub fn with_rest_factor(self, rest_factor: T) -> Self {
+        Self {
+            rest_factor,
+            ..self
+        }
+    }
+
+    /// The same settings with at most this many impacts per interval (see
+    /// [`max_impacts`](Self::max_impacts)).
+    #[must_use]
+    pub fn with_max_impacts(self, max_impacts: u32) -> Self {
+        Self {
+            max_impacts,
+            ..self
+        }
+    }
+
+    /// The same settings with this outlier factor (see
+    /// [`outlier_factor`](Self::outlier_factor)).
+    #[must_use]
+    pub fn with_outlier_factor(self, outlier_factor: T) -> Self {
+        Self {
+            outlier_factor,
+            ..self
+        }
+    }
+
+    /// The same settings with this many outliers in a row before a restart
+    /// (see [`max_outliers`](Self::max_outliers)).
+    #[must_use]
+    pub fn with_max_outliers(self, max_outliers: u32) -> Self {
+        Self {
+            max_outliers,
+            ..self
+        }
+    }
+
+    /// The same settings with the longest interval integrated (see
+    /// [`max_interval`](Self::max_interval)).
+    #[must_use]
+    pub fn with_max_interval(self, max_interval: T) -> Self {
+        Self {
+            max_interval,
+            ..self
+        }
+    }
+
     /// The largest distance `κ (C_v τ + 2 √N n_σ σ)` between two samples
     /// `τ` apart that is not an outlier (see
     /// [`outlier_factor`](Self::outlier_factor)).
