@@ -347,3 +347,87 @@ mod many_constraints {
         assert!(worst[0] < 1e-10 && worst[1] < 1e-10, "{worst:?}");
     }
 }
+
+/// A unit mass falling freely, no constraint, whose model is undefined
+/// below `y = −1` (its forces are NaN there, as a `sqrt` of a negative
+/// number would give).
+pub(crate) struct Cliff;
+
+impl Model<1, 0> for Cliff {
+    type Scalar = f64;
+    type Input = SVector<f64, 0>;
+    const INFO: ModelInfo<1, 0> = ModelInfo {
+        name: "Cliff",
+        coordinates: ["y"],
+        velocities: ["vy"],
+        constraints: [],
+        parameters: &[],
+        inputs: &[],
+        source: "",
+        op_count: 0,
+    };
+    fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> {
+        Matrix1::new(1.0)
+    }
+    fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> {
+        Matrix1::zeros()
+    }
+    fn gravity(&self, q: &Vector1<f64>) -> Vector1<f64> {
+        Vector1::new(if q[0] < -1.0 { f64::NAN } else { 9.81 })
+    }
+    fn forces(
+        &self,
+        _: f64,
+        q: &Vector1<f64>,
+        _: &Vector1<f64>,
+        _: &SVector<f64, 0>,
+    ) -> Vector1<f64> {
+        self.gravity(q)
+    }
+    fn gaps(&self, _: &Vector1<f64>) -> SVector<f64, 0> {
+        SVector::zeros()
+    }
+    fn gap_jacobian(&self, _: &Vector1<f64>) -> SMatrix<f64, 0, 1> {
+        SMatrix::zeros()
+    }
+    fn restitution(&self) -> SVector<f64, 0> {
+        SVector::zeros()
+    }
+    fn parameter(&self, _: usize) -> Option<f64> {
+        None
+    }
+    fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
+        None
+    }
+}
+
+/// Issue 9, defect 1: an observer whose own state leads its prediction
+/// where the model is undefined restarts from the measurement instead of
+/// refusing every update for good.
+#[cfg(test)]
+mod infeasible_state {
+    use super::Cliff;
+    use crate::{FullOrder, FullOrderGains, Observer, ObserverParams, ReducedOrder, Restart};
+    use nalgebra::{SVector, Vector1};
+
+    fn check<O: Observer<f64, 1, 0>>(mut o: O) {
+        let u = SVector::zeros();
+        // v̂ = −20 m/s predicts y = −2 m at 0.1 s, where F is NaN; the mass
+        // in fact rests at y = 0 (held by something outside the model)
+        let e = o.update(&Cliff, 0.1, &Vector1::new(0.0), &u).unwrap();
+        assert_eq!(o.report().restart, Some(Restart::Infeasible));
+        assert_eq!(e.v[0], 0.0); // the mean velocity over the interval
+        // and it goes on: the next interval is integrated
+        o.update(&Cliff, 0.101, &Vector1::new(0.0), &u).unwrap();
+        assert_eq!(o.report().restart, None);
+    }
+
+    #[test]
+    fn an_infeasible_prediction_restarts_both_observers() {
+        let params = ObserverParams::new(10.0, 20.0);
+        let v0 = Vector1::new(-20.0);
+        check(ReducedOrder::<f64, 1, 0>::new(params, 0.0, Vector1::new(0.0), v0).unwrap());
+        let gains = FullOrderGains::scalar(5.0, 25.0);
+        check(FullOrder::<f64, 1, 0>::new(params, gains, 0.0, Vector1::new(0.0), v0).unwrap());
+    }
+}

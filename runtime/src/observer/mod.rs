@@ -249,8 +249,8 @@
 //!   the observer's own state fails (the model, or an impact problem, fails
 //!   along the predicted motion), the estimate restarts from the measurement
 //!   with the mean velocity over the interval ([`Restart::Infeasible`]).
-//!   Only a failure at the measurement itself (the model undefined at `q`)
-//!   is an error.
+//!   Only a failure of the restart itself (Newton's law at the measured
+//!   `q`, where the model must be defined) is an error.
 //!
 //! After any restart the error is at most `C_v + |v|` and decays like any
 //! initial error, `e^{−l_d t}` for (38) (`tests/observer.rs`: below 1e-2 m/s
