@@ -41,8 +41,10 @@
 //!
 //! Corollary 2 (full order) asks `λ_min l_d > C_F + C_M C_v + β`,
 //! Corollary 3 (reduced order) `λ_min l_d ≥ 2 C_v C_M + 2 C_F + β`.
-//! [`ModelBounds::gain`] returns the `l_d` at which the condition holds
-//! with equality, [`ModelBounds::beta`] the margin `β` a given `l_d` leaves.
+//! [`ModelBounds::gain_for_margin`] returns the gain `l_d` at which the
+//! condition holds with equality, [`ModelBounds::margin`] the margin `β` a
+//! given `l_d` leaves; [`ModelBounds::gain_for_decay_rate`] the `l_d` of a
+//! decay rate (below). `β` is not a rate: the names keep the three apart.
 //!
 //! The paper's `β` is a margin in the units of `M` over time: with
 //! `W = ṽᵀ M ṽ`, the proof shows `dW/dt ≤ −2 l_d W + 2 (C_F + C_M C_v)|ṽ|²`

@@ -55,7 +55,7 @@ use crate::lcp::{IndexSet, Lcp};
 use crate::linalg::{Cholesky, Lu};
 use crate::model::Model;
 use crate::state::State;
-use crate::validate::{self, factor_mass, finite_model};
+use crate::validate;
 
 /// The Moreau–Jean stepper: settings and nothing else.
 ///
@@ -284,11 +284,11 @@ impl<T: RealField + Copy> MoreauJean<T> {
     {
         let State { t, q, v } = *state;
         let (gaps, jac) = model.contact(&q);
-        finite_model(&gaps, "h")?;
-        finite_model(&jac, "J")?;
+        finite_matrix(&gaps, "h")?;
+        finite_matrix(&jac, "J")?;
         let normal_velocity = jac * v;
         let forces = model.forces(t, &q, &v, u);
-        finite_model(&forces, "F")?;
+        finite_matrix(&forces, "F")?;
         Ok(Start {
             t_next,
             q,
@@ -316,15 +316,15 @@ impl<T: RealField + Copy> MoreauJean<T> {
     {
         let (tau, theta) = (self.params.tau, self.params.theta);
         let lin = model.linearization(start.t_next, &q, &v, u);
-        let mass = factor_mass(&lin.mass)?;
-        finite_model(&lin.forces, "F")?;
+        let mass = check_mass(&lin.mass)?;
+        finite_matrix(&lin.forces, "F")?;
         let w = iteration_matrix(&lin.mass, mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
         // FREE VELOCITY: v_free = ṽ − W⁻¹ R(q̃, ṽ)
         let residual = lin.mass * (v - start.v) + self.force_impulse(start, &lin.forces);
         let v_free = v - solve(&w, &residual)?;
         // IMPULSES: Newton's law compares J v_{k+1} with e u
         let jac = model.gap_jacobian(&q);
-        finite_model(&jac, "J")?;
+        finite_matrix(&jac, "J")?;
         let approach = match self.params.approach_velocity {
             ApproachVelocity::Start => start.normal_velocity,
             ApproachVelocity::Iterate => jac * start.v,
@@ -496,7 +496,7 @@ fn iteration_matrix<T: RealField + Copy, const N: usize>(
     }
     let h_theta = tau * theta;
     let w = m + forces_dv * h_theta + forces_dq * (h_theta * h_theta);
-    finite_model(&w, "W")?;
+    finite_matrix(&w, "W")?;
     Lu::new(&w)
         .map(Factor::Lu)
         .ok_or(StepError::SingularIterationMatrix)
@@ -583,4 +583,21 @@ where
     validate::model_and_input(model, u)?;
     validate::restitution(&model.restitution())?;
     Ok(())
+}
+
+/// Checks that `M` is positive definite and returns its Cholesky factor
+/// (the shared check, [`validate::factor_mass`]).
+fn check_mass<T: RealField + Copy, const N: usize>(
+    m: &SMatrix<T, N, N>,
+) -> Result<Cholesky<T, N>, StepError<T>> {
+    Ok(validate::factor_mass(m)?)
+}
+
+/// Rejects a non-finite model term (the shared check,
+/// [`validate::finite_model`]).
+fn finite_matrix<T: RealField + Copy, const R: usize, const C: usize>(
+    m: &SMatrix<T, R, C>,
+    which: &'static str,
+) -> Result<(), StepError<T>> {
+    Ok(validate::finite_model(m, which)?)
 }
