@@ -58,7 +58,11 @@
 //! let model = Parabola::<f64>::default();
 //! let region = GainRegion::new(Vector2::new(-3.0, 0.0), Vector2::new(3.0, 8.0), 20.0);
 //! let bounds = ModelBounds::estimate(&model, &region, &SVector::zeros())?;
-//! let l_d = bounds.gain(Design::ReducedOrder, 10.0); // decay rate β = 10
+//! let beta = 10.0; // Corollary 3's margin β (kg/s), not a rate
+//! let l_d = bounds.gain_for_margin(Design::ReducedOrder, beta); // the gain l_d (1/s)
+//! let rate = bounds.decay_rate(l_d); // the guaranteed decay rate of |v − v̂| (1/s)
+//! // Example 1's force bounds vanish and its mass is 1 kg: both are 10 here
+//! assert!((l_d - 10.0).abs() < 1e-9 && (rate - 10.0).abs() < 1e-9);
 //! let params = ObserverParams::new(l_d, 20.0); // gain l_d, velocity bound C_v
 //! let mut observer = ReducedOrder::new(params, 0.0, q0, Vector2::zeros())?;
 //! for (t, q) in &samples {

@@ -8,8 +8,9 @@
 //! every measured figure.
 
 use moreau::{
-    Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, Model, ModelBounds,
-    MoreauJean, Observer, ObserverError, ObserverParams, ReducedOrder, State, StepParams,
+    DataError, Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, Model,
+    ModelBounds, MoreauJean, Observer, ObserverError, ObserverParams, ReducedOrder, Restart, State,
+    StepParams,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
@@ -61,8 +62,7 @@ where
             }
         }
         if k % every == 0 {
-            // the plant's t accumulates round-off: sample at exactly j τ_s
-            state.t = (k / every) as f64 * tau * every as f64;
+            // the stepper keeps t on its grid kτ: no round-off to correct
             samples.push(state);
         }
     }
@@ -633,7 +633,7 @@ fn smooth_decay_is_at_least_the_guaranteed_rate() {
             .all(|s| pendulum.gaps(&s.q).min() > 1e-3)
     );
     let bounds = bounds_along(&pendulum, &data, 0.45, &zero);
-    let l_d = bounds.gain(Design::ReducedOrder, 1.0).ceil();
+    let l_d = bounds.gain_for_margin(Design::ReducedOrder, 1.0).ceil();
     let v_hat0 = Vector2::new(1.0, -1.0);
     decays_at_the_guaranteed_rate("double pendulum", &pendulum, &data, &bounds, l_d, v_hat0);
 }
@@ -661,10 +661,10 @@ fn decays_at_the_guaranteed_rate<M>(
         bounds.coriolis,
         bounds.force_lipschitz,
         bounds.velocity_bound,
-        bounds.beta(Design::FullOrder, l_d),
-        bounds.beta(Design::ReducedOrder, l_d),
+        bounds.margin(Design::FullOrder, l_d),
+        bounds.margin(Design::ReducedOrder, l_d),
     );
-    assert!(rate >= bounds.beta(Design::ReducedOrder, l_d) - 1e-12);
+    assert!(rate >= bounds.margin(Design::ReducedOrder, l_d) - 1e-12);
     let params = ObserverParams::new(l_d, bounds.velocity_bound);
     let measured = measure(data, 0.0, 0);
 
@@ -1086,17 +1086,17 @@ fn bad_input_is_refused_and_the_state_kept() {
     let cases: [(Outcome, ObserverError<f64>); 7] = [
         (
             observer.update(&arm, last.t, &nan_q, &u),
-            ObserverError::NonFiniteMeasurement {
+            ObserverError::Data(DataError::NonFinite {
                 which: "q",
                 index: 1,
-            },
+            }),
         ),
         (
             observer.update(&arm, last.t, &Vector3::repeat(f64::INFINITY), &u),
-            ObserverError::NonFiniteMeasurement {
+            ObserverError::Data(DataError::NonFinite {
                 which: "q",
                 index: 0,
-            },
+            }),
         ),
         (
             observer.update(&arm, f64::NAN, &last.q, &u),
@@ -1114,20 +1114,20 @@ fn bad_input_is_refused_and_the_state_kept() {
         ),
         (
             observer.update(&arm, last.t, &last.q, &Vector3::new(0.0, 0.0, f64::NAN)),
-            ObserverError::NonFiniteInput { index: 2 },
+            ObserverError::Data(DataError::NonFiniteInput { index: 2 }),
         ),
         (
             observer.update(&bad_model, last.t, &last.q, &u),
-            ObserverError::NonFiniteParameter {
+            ObserverError::Data(DataError::NonFiniteParameter {
                 index: Arm3::<f64>::parameter_index("g").unwrap(),
-            },
+            }),
         ),
         (
             observer.update(&bad_e, last.t, &last.q, &u),
-            ObserverError::InvalidRestitution {
+            ObserverError::Data(DataError::InvalidRestitution {
                 constraint: 0,
                 value: 1.5,
-            },
+            }),
         ),
     ];
     for (result, expected) in cases {
@@ -1157,22 +1157,22 @@ fn bad_input_is_refused_and_the_state_kept() {
     };
     assert!(matches!(
         bad(ObserverParams::new(0.0, 1.0)),
-        ObserverError::InvalidParams { name: "l_d", .. }
+        ObserverError::Data(DataError::InvalidParams { name: "l_d", .. })
     ));
     assert!(matches!(
         bad(ObserverParams::new(f64::NAN, 1.0)),
-        ObserverError::InvalidParams { name: "l_d", .. }
+        ObserverError::Data(DataError::InvalidParams { name: "l_d", .. })
     ));
     assert!(matches!(
         bad(ObserverParams::new(1.0, -1.0)),
-        ObserverError::InvalidParams {
+        ObserverError::Data(DataError::InvalidParams {
             name: "velocity_bound",
             ..
-        }
+        })
     ));
     assert!(matches!(
         bad(ObserverParams::new(1.0, 1.0).with_noise(f64::NAN)),
-        ObserverError::InvalidParams { name: "noise", .. }
+        ObserverError::Data(DataError::InvalidParams { name: "noise", .. })
     ));
     let gains = FullOrderGains {
         lambda: SMatrix::<f64, 3, 3>::from_diagonal(&Vector3::new(1.0, -1.0, 1.0)),
@@ -1180,20 +1180,26 @@ fn bad_input_is_refused_and_the_state_kept() {
     };
     assert!(matches!(
         FullOrder::<f64, 3, 1>::new(params, gains, 0.0, start.q, start.v),
-        Err(ObserverError::InvalidParams { name: "lambda", .. })
+        Err(ObserverError::Data(DataError::InvalidParams {
+            name: "lambda",
+            ..
+        }))
     ));
     assert!(matches!(
         ReducedOrder::<f64, 3, 1>::new(params, 0.0, start.q, start.v)
             .unwrap()
             .with_restitution(SVector::repeat(-0.1)),
-        Err(ObserverError::InvalidRestitution { constraint: 0, .. })
+        Err(ObserverError::Data(DataError::InvalidRestitution {
+            constraint: 0,
+            ..
+        }))
     ));
     assert!(matches!(
         ReducedOrder::<f64, 3, 1>::new(params, 0.0, Vector3::new(0.0, f64::NAN, 0.0), start.v),
-        Err(ObserverError::NonFiniteMeasurement {
+        Err(ObserverError::Data(DataError::NonFinite {
             which: "q0",
             index: 1
-        })
+        }))
     ));
 }
 
@@ -1317,4 +1323,254 @@ fn observers_run_in_f32() {
         assert!(at_two < 1e-2, "{name}: {at_two}");
         assert!(late.median < 1e-3, "{name}: {late:?}");
     }
+}
+
+// ---------------------------------------------------------------------------
+// Bad samples, bad states, long gaps (issue 9, defects 1 and 2)
+// ---------------------------------------------------------------------------
+
+/// The reproducer of issue 9: Example 1 with its plant at `τ = 1e-5`,
+/// sampled at 1 kHz, `l_d = 10`, `C_v = 20`, `v̂(0) = 0`; `sample(k, q)`
+/// may change the measurement. Returns, per observer (reduced, full), the
+/// results of every update and the velocity error after it.
+type Run = Vec<(Result<Estimate<f64, 2>, ObserverError<f64>>, f64)>;
+fn example_1_stream(
+    v0: Vector2<f64>,
+    samples: usize,
+    sample: impl Fn(usize, Vector2<f64>) -> Option<(f64, Vector2<f64>)>,
+) -> [Run; 2] {
+    let (model, u) = (Parabola::<f64>::new(), SVector::<f64, 0>::zeros());
+    let (q0, plant_v0) = Parabola::<f64>::initial_state();
+    let stepper = MoreauJean::new(StepParams::new(1e-5)).unwrap();
+    let mut plant = State::new(0.0, q0, plant_v0);
+    let params = ObserverParams::new(10.0, 20.0);
+    let mut ro = ReducedOrder::<f64, 2, 2>::new(params, 0.0, q0, v0).unwrap();
+    let gains = FullOrderGains::scalar(5.0, 25.0);
+    let mut fo = FullOrder::<f64, 2, 2>::new(params, gains, 0.0, q0, v0).unwrap();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for k in 1..=samples {
+        for _ in 0..100 {
+            stepper.step(&model, &mut plant, &u).unwrap();
+        }
+        let Some((t, q)) = sample(k, plant.q) else {
+            continue;
+        };
+        let ra = ro.update(&model, t, &q, &u);
+        a.push((ra, (ro.estimate().v - plant.v).norm()));
+        let rb = fo.update(&model, t, &q, &u);
+        b.push((rb, (fo.estimate().v - plant.v).norm()));
+    }
+    [a, b]
+}
+
+/// Issue 9, defect 1: one finite glitch of 1e2 to 1e6 m (a bad encoder
+/// read, a unit slip) used to drive the estimate to 1e4–1e300 and wedge
+/// both observers (every later update `Lcp(Infeasible)`). Now the sample
+/// is refused as an outlier, the estimate kept bit for bit, and every
+/// later update succeeds: recovery in 0 samples, the run bit-identical to
+/// one that never saw the bad sample; the next report counts it.
+#[test]
+fn a_finite_glitch_is_skipped_as_an_outlier() {
+    let clean = example_1_stream(Vector2::zeros(), 3000, |k, q| {
+        (k != 1000).then_some((k as f64 * 1e-3, q))
+    });
+    for glitch in [1e2, 1e3, 1e4, 1e5, 1e6] {
+        let runs = example_1_stream(Vector2::zeros(), 3000, |k, q| {
+            let q = if k == 1000 {
+                q + Vector2::new(glitch, glitch)
+            } else {
+                q
+            };
+            Some((k as f64 * 1e-3, q))
+        });
+        for (run, clean) in runs.iter().zip(&clean) {
+            assert!(
+                matches!(run[999].0, Err(ObserverError::Outlier { .. })),
+                "{:?}",
+                run[999].0
+            );
+            let after: Vec<_> = run[..999].iter().chain(&run[1000..]).collect();
+            assert_eq!(after.len(), clean.len());
+            for (k, ((r, e), (c, ec))) in after.iter().zip(clean).enumerate() {
+                let r = r.as_ref().unwrap_or_else(|e| panic!("sample {k}: {e}"));
+                let c = c.as_ref().unwrap();
+                assert_eq!(bits(&[*r]), bits(&[*c]), "sample {k}");
+                assert_eq!(e, ec);
+            }
+        }
+        eprintln!(
+            "glitch {glitch:e} m at sample 1000: refused as an outlier; |v − v̂| at 3 s {:.1e} (reduced), {:.1e} (full)",
+            runs[0][2999].1, runs[1][2999].1
+        );
+    }
+}
+
+/// Issue 9, defect 1: a burst of ten bad samples in a row (finite, up to
+/// 1e6 m, none near another) is refused sample by sample; as they do not
+/// agree with each other, the estimate never restarts from one, and the run
+/// goes on bit-identical to one that never saw them; the next report counts
+/// ten skipped samples.
+#[test]
+fn a_burst_of_bad_samples_is_skipped() {
+    let bad = |k: usize| 1e6 * (k as f64 - 1004.5) / 5.0;
+    let clean = example_1_stream(Vector2::zeros(), 2000, |k, q| {
+        (!(1000..1010).contains(&k)).then_some((k as f64 * 1e-3, q))
+    });
+    let runs = example_1_stream(Vector2::zeros(), 2000, |k, q| {
+        let q = if (1000..1010).contains(&k) {
+            q + Vector2::new(bad(k), -bad(k))
+        } else {
+            q
+        };
+        Some((k as f64 * 1e-3, q))
+    });
+    for (run, clean) in runs.iter().zip(&clean) {
+        for r in &run[999..1009] {
+            assert!(
+                matches!(r.0, Err(ObserverError::Outlier { .. })),
+                "{:?}",
+                r.0
+            );
+        }
+        let after: Vec<_> = run[..999].iter().chain(&run[1009..]).collect();
+        for (k, ((r, _), (c, _))) in after.iter().zip(clean).enumerate() {
+            assert_eq!(
+                bits(&[*r.as_ref().unwrap()]),
+                bits(&[*c.as_ref().unwrap()]),
+                "{k}"
+            );
+        }
+    }
+    // the count, on the reduced-order observer alone
+    let (model, u) = (Parabola::<f64>::new(), SVector::<f64, 0>::zeros());
+    let (q0, _) = Parabola::<f64>::initial_state();
+    let params = ObserverParams::new(10.0, 20.0);
+    let mut ro = ReducedOrder::<f64, 2, 2>::new(params, 0.0, q0, Vector2::zeros()).unwrap();
+    for k in 1000..1010 {
+        let q = q0 + Vector2::new(bad(k), -bad(k));
+        assert!(ro.update(&model, (k - 999) as f64 * 1e-4, &q, &u).is_err());
+    }
+    ro.update(&model, 1.1e-3, &q0, &u).unwrap();
+    assert_eq!((ro.report().outliers, ro.report().restart), (10, None));
+}
+
+/// Issue 9, defect 1: an observer started from a wrong first measurement
+/// (1e3 m off: a unit slip) sees every sample as an outlier; the samples
+/// agree with each other, so after `max_outliers` = 3 refusals the 4th
+/// restarts the estimate from the measurement, and from there it converges
+/// as from any start (below 1e-2 m/s within 1000 samples; measured: 680
+/// reduced, 803 full) instead of refusing every sample for good.
+#[test]
+fn samples_that_agree_with_each_other_restart_the_estimate() {
+    let model = Parabola::<f64>::new();
+    let (q0, v0) = Parabola::<f64>::initial_state();
+    let wrong = q0 + Vector2::new(1e3, 1e3);
+    let stepper = MoreauJean::new(StepParams::new(1e-5)).unwrap();
+    let params = ObserverParams::new(10.0, 20.0);
+    let ro = ReducedOrder::<f64, 2, 2>::new(params, 0.0, wrong, Vector2::zeros()).unwrap();
+    let gains = FullOrderGains::scalar(5.0, 25.0);
+    let fo = FullOrder::<f64, 2, 2>::new(params, gains, 0.0, wrong, Vector2::zeros()).unwrap();
+    fn run<O: Observer<f64, 2, 2>>(
+        mut o: O,
+        name: &str,
+        model: &Parabola<f64>,
+        stepper: &MoreauJean<f64>,
+        start: State<f64, 2>,
+    ) {
+        let u = SVector::zeros();
+        let mut plant = start;
+        let mut last_bad = 0;
+        for k in 1..=2000 {
+            for _ in 0..100 {
+                stepper.step(model, &mut plant, &u).unwrap();
+            }
+            let r = o.update(model, k as f64 * 1e-3, &plant.q, &u);
+            match k {
+                1..=3 => assert!(matches!(r, Err(ObserverError::Outlier { .. })), "{r:?}"),
+                4 => {
+                    r.unwrap();
+                    assert_eq!(o.report().restart, Some(Restart::Outliers));
+                    assert_eq!(o.report().outliers, 3);
+                }
+                _ => {
+                    r.unwrap();
+                }
+            }
+            if (o.estimate().v - plant.v).norm() >= 1e-2 {
+                last_bad = k;
+            }
+        }
+        eprintln!(
+            "wrong first measurement ({name}): restarted at sample 4, |v − v̂| below 1e-2 from sample {} on",
+            last_bad + 1
+        );
+        assert!(last_bad < 1000, "{last_bad}");
+    }
+    let start = State::new(0.0, q0, v0);
+    run(ro, "reduced", &model, &stepper, start);
+    run(fo, "full", &model, &stepper, start);
+}
+
+/// Issue 9, defect 1: a huge initial guess `v̂(0) = (1e5, −1e5)` used to
+/// wedge both observers. The estimate is held to `C_v = 20`, so the error
+/// starts at most `C_v + |v(0)|` = 30 m/s and decays like `e^{−r t}`,
+/// `r = l_d = 10` for (38) and `r = 7.5` for (36) (the real part of the
+/// eigenvalues of its error system with `Λ = 5`, `L_ρ1 = 25`): below 1e-2
+/// m/s after `ln(30/1e-2)/r` = 0.80 s and 1.07 s; asserted within 1000 and
+/// 1200 samples (measured: reduced 777, full 1085).
+#[test]
+fn a_huge_initial_velocity_guess_recovers() {
+    let runs = example_1_stream(Vector2::new(1e5, -1e5), 2000, |k, q| {
+        Some((k as f64 * 1e-3, q))
+    });
+    for (run, limit) in runs.iter().zip([1000, 1200]) {
+        assert!(run.iter().all(|r| r.0.is_ok()));
+        assert!(run.iter().all(|r| r.0.as_ref().unwrap().v.norm() <= 20.0));
+        let recovered = run.iter().rposition(|r| r.1 >= 1e-2).map_or(0, |k| k + 1);
+        eprintln!("v̂(0) = (1e5, −1e5): |v − v̂| below 1e-2 from sample {recovered} on");
+        assert!(recovered <= limit, "{recovered}");
+    }
+}
+
+/// Issue 9, defect 2: a gap of 1 s between two samples used to give an
+/// error of 573 m/s with `Ok`, and 1e6 s gave `v̂ = −1.4e24`. A gap longer
+/// than `max_interval` (`3/l_d` = 0.3 s) restarts from the measurement
+/// with the mean velocity over the gap, held to `C_v`, and the report says
+/// so; the error then decays as from any start, below 1e-2 m/s within
+/// 1000 samples.
+#[test]
+fn a_long_gap_gives_a_bounded_flagged_estimate() {
+    for gap in [1.0, 1e6] {
+        // samples up to 1 s, then none until 1 s + gap, then on
+        let runs = example_1_stream(Vector2::zeros(), 4000, |k, q| {
+            let t = k as f64 * 1e-3;
+            match k {
+                ..=1000 => Some((t, q)),
+                1001..2000 => None,
+                _ => Some((t + gap - 1.0, q)),
+            }
+        });
+        for (which, run) in runs.iter().enumerate() {
+            let (first, error) = &run[1000];
+            let first = first.as_ref().unwrap();
+            assert!(first.v.norm() <= 20.0, "{}", first.v);
+            let recovered = run.iter().rposition(|r| r.1 >= 1e-2).unwrap() + 1 - 1000;
+            eprintln!(
+                "gap {gap:e} s ({}): first estimate |v̂| = {:.1}, |v − v̂| = {error:.1}; below 1e-2 after {recovered} samples",
+                ["reduced", "full"][which],
+                first.v.norm()
+            );
+            assert!(run.iter().all(|r| r.0.is_ok()));
+            assert!(recovered <= 1000, "{recovered}");
+        }
+    }
+    // the report says it
+    let (model, u) = (Parabola::<f64>::new(), SVector::<f64, 0>::zeros());
+    let (q0, _) = Parabola::<f64>::initial_state();
+    let params = ObserverParams::new(10.0, 20.0);
+    let mut ro = ReducedOrder::<f64, 2, 2>::new(params, 0.0, q0, Vector2::zeros()).unwrap();
+    ro.update(&model, 1.0, &q0, &u).unwrap();
+    assert_eq!(ro.report().restart, Some(Restart::LongInterval));
+    ro.update(&model, 1.001, &q0, &u).unwrap();
+    assert_eq!(ro.report().restart, None);
 }

@@ -5,7 +5,9 @@
 
 mod common;
 
-use moreau::{ApproachVelocity, LcpError, Model, MoreauJean, State, StepError, StepParams};
+use moreau::{
+    ApproachVelocity, DataError, LcpError, Model, MoreauJean, State, StepError, StepParams,
+};
 use moreau_models::{Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SVector, Vector2, Vector3, Vector4};
 
@@ -51,8 +53,7 @@ where
 {
     let reference = siconos::<N>(stem);
     let model = M::default();
-    let mut params = StepParams::new(1e-3);
-    params.approach_velocity = approach;
+    let params = StepParams::new(1e-3).with_approach_velocity(approach);
     let stepper = MoreauJean::new(params).unwrap();
     let u = SVector::zeros();
     let mut worst_step = (0.0_f64, 0);
@@ -154,8 +155,7 @@ fn siconos_law_gains_energy_on_a_dispersing_billiard() {
         restitution: Vector4::repeat(1.0),
         ..Default::default()
     };
-    let mut params = StepParams::new(1e-3);
-    params.approach_velocity = ApproachVelocity::Start;
+    let params = StepParams::siconos(1e-3);
     let stepper = MoreauJean::new(params).unwrap();
     let mut state = State::new(0.0, Vector2::new(0.05, 0.1), Vector2::new(1.5, 0.7));
     let e0 = 0.5 * state.v.norm_squared();
@@ -431,35 +431,38 @@ fn bad_input_is_an_error_and_leaves_the_state_alone() {
     let e = refused(&parabola, &stepper, State::new(0.0, nan_q, v0));
     assert_eq!(
         e,
-        StepError::NonFiniteState {
+        StepError::Data(DataError::NonFinite {
             which: "q",
             index: 1
-        }
+        })
     );
 
     let e = refused(&parabola, &stepper, State::new(f64::INFINITY, q0, v0));
     assert_eq!(
         e,
-        StepError::NonFiniteState {
+        StepError::Data(DataError::NonFinite {
             which: "t",
             index: 0
-        }
+        })
     );
 
     let mut bad = parabola;
     bad.g = f64::NAN;
     let e = refused(&bad, &stepper, State::new(0.0, q0, v0));
-    assert_eq!(e, StepError::NonFiniteParameter { index: 1 });
+    assert_eq!(
+        e,
+        StepError::Data(DataError::NonFiniteParameter { index: 1 })
+    );
 
     let mut bad = parabola;
     bad.restitution[0] = 1.5;
     let e = refused(&bad, &stepper, State::new(0.0, q0, v0));
     assert_eq!(
         e,
-        StepError::InvalidRestitution {
+        StepError::Data(DataError::InvalidRestitution {
             constraint: 0,
             value: 1.5
-        }
+        })
     );
 
     let balls = ThreeBalls::<f64> {
@@ -468,7 +471,7 @@ fn bad_input_is_an_error_and_leaves_the_state_alone() {
     };
     let (q0, v0) = ThreeBalls::<f64>::initial_state();
     let e = refused(&balls, &stepper, State::new(0.0, q0, v0));
-    assert_eq!(e, StepError::MassNotPositiveDefinite);
+    assert_eq!(e, StepError::Data(DataError::MassNotPositiveDefinite));
 
     let mut params = StepParams::new(1e-3);
     params.gamma = 0.0;
@@ -483,14 +486,17 @@ fn bad_input_is_an_error_and_leaves_the_state_alone() {
         ),
     );
     assert!(
-        matches!(e, StepError::Lcp(LcpError::Infeasible { .. })),
+        matches!(
+            e,
+            StepError::Data(DataError::Lcp(LcpError::Infeasible { .. }))
+        ),
         "{e:?}"
     );
 
     for (name, tau) in [("tau", 0.0), ("tau", -1e-3), ("tau", f64::NAN)] {
         let e = MoreauJean::new(StepParams::new(tau)).unwrap_err();
         assert!(
-            matches!(e, StepError::InvalidParams { name: n, .. } if n == name),
+            matches!(e, StepError::Data(DataError::InvalidParams { name: n, .. }) if n == name),
             "{e:?}"
         );
     }
@@ -528,4 +534,105 @@ fn example_1_runs_in_f32() {
         );
     }
     assert!(impacts >= 3, "{impacts}");
+}
+
+/// Issue 9, defect 3: a step whose time cannot advance in the scalar type
+/// is refused before anything changes (it used to return `Ok` with `q` and
+/// `v` moved and `t` stuck, so a `while t < t_end` loop never ended).
+#[test]
+fn time_that_cannot_advance_is_an_error() {
+    // f32 at t = 32768 s with τ = 1 ms: t + τ == t
+    let m32 = Parabola::<f32>::default();
+    let (q, v) = Parabola::<f32>::initial_state();
+    let s32 = MoreauJean::new(StepParams::new(1e-3_f32)).unwrap();
+    assert_eq!(32768.0_f32 + 1e-3, 32768.0);
+    let before = State::new(32768.0_f32, q, v);
+    let mut state = before;
+    let e = s32.step(&m32, &mut state, &SVector::zeros()).unwrap_err();
+    assert_eq!(
+        e,
+        StepError::TimeDoesNotAdvance {
+            t: 32768.0,
+            tau: 1e-3
+        }
+    );
+    assert_eq!(state, before);
+    // f64 at t = 1e17 s
+    let m64 = Parabola::<f64>::default();
+    let (q, v) = Parabola::<f64>::initial_state();
+    let s64 = MoreauJean::new(StepParams::new(1e-3)).unwrap();
+    assert_eq!(1e17 + 1e-3, 1e17);
+    let before = State::new(1e17, q, v);
+    let mut state = before;
+    let e = s64.step(&m64, &mut state, &SVector::zeros()).unwrap_err();
+    assert!(
+        matches!(e, StepError::TimeDoesNotAdvance { t, .. } if t == 1e17),
+        "{e:?}"
+    );
+    assert_eq!(state, before);
+    // τ = f64::MIN_POSITIVE: τ²θ² underflows, and 1 + τ == 1
+    let e = MoreauJean::new(StepParams::new(f64::MIN_POSITIVE)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            StepError::Data(DataError::InvalidParams { name: "tau", .. })
+        ),
+        "{e:?}"
+    );
+    // the limit: 16 ε |t| < τ steps, 16 ε |t| ≥ τ does not (f32, τ = 1 ms:
+    // 524.3 s); at 8192 s, where adding τ rounds to 0.977 ms and summed
+    // time ran 2.3 % slow, the step is refused
+    let limit = 1e-3_f32 / (16.0 * f32::EPSILON);
+    let mut state = State::new(limit * 0.999, q.cast(), v.cast());
+    assert!(s32.step(&m32, &mut state, &SVector::zeros()).is_ok());
+    for t in [limit * 1.001, 8192.0] {
+        let mut state = State::new(t, q.cast(), v.cast());
+        assert!(matches!(
+            s32.step(&m32, &mut state, &SVector::zeros()),
+            Err(StepError::TimeDoesNotAdvance { .. })
+        ));
+    }
+}
+
+/// Issue 9, defect 3: time is counted on the grid `kτ`, so it does not
+/// drift over long runs: in `f64` over 10⁵ steps `t_k` is `kτ` rounded,
+/// bit for bit (summing `τ` is off by 1e-10 s after these steps); in `f32`
+/// from `t = 500` s, where adding `τ = 1` ms rounds by up to 1.5 % of it,
+/// 1000 steps advance 1 s to within an ulp.
+#[test]
+fn time_stays_on_the_grid_over_long_runs() {
+    let model = Parabola::<f64>::default();
+    let (q0, v0) = Parabola::<f64>::initial_state();
+    let tau = 1e-3;
+    let stepper = MoreauJean::new(StepParams::new(tau)).unwrap();
+    let mut state = State::new(0.0, q0, v0);
+    let mut summed = 0.0_f64;
+    for k in 1..=100_000_u32 {
+        stepper.step(&model, &mut state, &SVector::zeros()).unwrap();
+        summed += tau;
+        assert_eq!(state.t, f64::from(k) * tau, "step {k}");
+    }
+    eprintln!(
+        "f64, 1e5 steps of 1 ms: t = {}, a sum of τ = {summed} (off by {:.1e})",
+        state.t,
+        (summed - state.t).abs()
+    );
+    assert!((summed - state.t).abs() > 1e-12);
+
+    let model = Parabola::<f32>::default();
+    let (q0, v0) = Parabola::<f32>::initial_state();
+    let stepper = MoreauJean::new(StepParams::new(1e-3_f32)).unwrap();
+    let mut state = State::new(500.0_f32, q0, v0);
+    let mut summed = 500.0_f32;
+    for _ in 0..1000 {
+        stepper.step(&model, &mut state, &SVector::zeros()).unwrap();
+        summed += 1e-3;
+    }
+    let ulp = 501.0_f32 * f32::EPSILON;
+    eprintln!(
+        "f32 from 500 s, 1000 steps of 1 ms: t = {}, a sum of τ = {summed}",
+        state.t
+    );
+    assert!((state.t - 501.0).abs() <= ulp, "{}", state.t);
+    assert!((summed - 501.0).abs() > 100.0 * ulp);
 }

@@ -9,7 +9,7 @@
 use std::process::Command;
 use std::time::Instant;
 
-use moreau::{ApproachVelocity, Model, MoreauJean, State, StepParams};
+use moreau::{Model, MoreauJean, State, StepParams};
 use moreau_models::{DoublePendulum, Parabola};
 use nalgebra::SVector;
 
@@ -23,8 +23,7 @@ fn moreau_per_step<M, const N: usize, const K: usize>(
 where
     M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>>,
 {
-    let mut params = StepParams::new(1e-3);
-    params.approach_velocity = ApproachVelocity::Start;
+    let params = StepParams::siconos(1e-3);
     let stepper = MoreauJean::new(params).unwrap();
     let mut best = f64::INFINITY;
     for _ in 0..5 {

@@ -9,19 +9,25 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
+mod error;
 mod lcp;
 mod linalg;
 mod model;
 mod observer;
+mod state;
 mod stepper;
+#[cfg(test)]
+mod testing;
+mod validate;
 
+pub use error::DataError;
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Sensitivities, Terms};
 pub use observer::{
-    Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
-    ObserverError, ObserverParams, ReducedOrder, UpdateReport,
+    Design, Discretization, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
+    ObserverError, ObserverParams, ReducedOrder, Restart, UpdateReport,
 };
+pub use state::{Estimate, State};
 pub use stepper::{
-    ApproachVelocity, Impact, MoreauJean, State, StepError, StepParams, StepReport,
-    predict_index_set,
+    ApproachVelocity, Impact, MoreauJean, StepError, StepParams, StepReport, predict_index_set,
 };

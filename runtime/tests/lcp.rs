@@ -27,7 +27,7 @@ type Vect = SVector<f64, K>;
 struct Case {
     W: Mat,
     b: Vect,
-    active: IndexSet,
+    active: IndexSet<K>,
     /// `W = AAᵀ + εI` with `ε ≥ 0.05`: `λ` is unique and well conditioned.
     definite: bool,
 }
@@ -65,7 +65,7 @@ fn scales(W: &DMatrix<f64>, b: &DVector<f64>) -> (f64, f64) {
     (b.amax(), W.amax())
 }
 
-fn hide_inactive(W: &mut Mat, b: &mut Vect, active: IndexSet) {
+fn hide_inactive(W: &mut Mat, b: &mut Vect, active: IndexSet<K>) {
     for i in 0..K {
         if !active.contains(i) {
             b[i] = f64::NAN;
@@ -106,7 +106,7 @@ fn definite_case() -> impl Strategy<Value = Case> {
         .prop_map(|(mask, n, a, eps, mode, u, c, d)| {
             let A = Mat::from_fn(|i, j| if j < n { a[i][j] } else { 0.0 });
             let W = A * A.transpose() + Mat::identity() * eps;
-            let active = IndexSet::from_bits(u32::from(mask));
+            let active = IndexSet::from_bits(u64::from(mask)).unwrap();
             let mut b = make_b(&W, mode, &u, &c, &d);
             let mut W = W;
             hide_inactive(&mut W, &mut b, active);
@@ -159,11 +159,15 @@ fn degenerate_case() -> impl Strategy<Value = Case> {
                 }
             }
             let mut W = W;
-            hide_inactive(&mut W, &mut b, IndexSet::from_bits(u32::from(mask)));
+            hide_inactive(
+                &mut W,
+                &mut b,
+                IndexSet::from_bits(u64::from(mask)).unwrap(),
+            );
             Case {
                 W,
                 b,
-                active: IndexSet::from_bits(u32::from(mask)),
+                active: IndexSet::from_bits(u64::from(mask)).unwrap(),
                 definite: false,
             }
         })
@@ -453,7 +457,7 @@ fn projection(
     J: &SMatrix<f64, K, N>,
     c: &Vect,
     v_minus: &SVector<f64, N>,
-    active: IndexSet,
+    active: IndexSet<K>,
 ) -> Option<SVector<f64, N>> {
     let L = M.cholesky().expect("M is positive definite").l();
     let L_inv_t = L.transpose().try_inverse().expect("L is invertible");
@@ -500,7 +504,7 @@ fn impact(
     J: &SMatrix<f64, K, N>,
     c: &Vect,
     v_minus: &SVector<f64, N>,
-    active: IndexSet,
+    active: IndexSet<K>,
 ) -> Result<SVector<f64, N>, LcpError<f64>> {
     impact_with_residual(M, J, c, v_minus, active).map(|(v, _)| v)
 }
@@ -511,7 +515,7 @@ fn impact_with_residual(
     J: &SMatrix<f64, K, N>,
     c: &Vect,
     v_minus: &SVector<f64, N>,
-    active: IndexSet,
+    active: IndexSet<K>,
 ) -> Result<(SVector<f64, N>, f64), LcpError<f64>> {
     let M_inv = M.try_inverse().expect("M is invertible");
     let W = J * M_inv * J.transpose();
@@ -621,7 +625,7 @@ fn impact_case() -> impl Strategy<
         SMatrix<f64, K, N>,
         Vect,
         SVector<f64, N>,
-        IndexSet,
+        IndexSet<K>,
     ),
 > {
     (
@@ -673,7 +677,7 @@ fn impact_case() -> impl Strategy<
                     e[i] * (J.row(i) * v)[0]
                 }
             });
-            (M, J, c, v, IndexSet::from_bits(u32::from(mask)))
+            (M, J, c, v, IndexSet::from_bits(u64::from(mask)).unwrap())
         })
 }
 

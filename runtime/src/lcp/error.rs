@@ -66,6 +66,15 @@ pub enum LcpError<T> {
         /// The largest number enumerated.
         max: usize,
     },
+    /// More than [`Lcp::MAX_ACTIVE`](crate::Lcp::MAX_ACTIVE) rows active in
+    /// one problem (a model may have any number of constraints; this many
+    /// at once is refused, never cut short).
+    ActiveSetTooLarge {
+        /// The number of active rows.
+        active: usize,
+        /// The most one problem takes.
+        max: usize,
+    },
     /// A complementary set was found, but the complementarity residual of the
     /// returned `(λ, w)` exceeds the tolerance (ill-conditioned `W`).
     ResidualTooLarge {
@@ -106,6 +115,10 @@ impl<T: fmt::Display> fmt::Display for LcpError<T> {
             Self::TooManyActive { active, max } => write!(
                 f,
                 "LCP with {active} active rows was not solved by pivoting and is too large to enumerate (at most {max})"
+            ),
+            Self::ActiveSetTooLarge { active, max } => write!(
+                f,
+                "LCP with {active} active rows at once: at most {max} are solved"
             ),
             Self::ResidualTooLarge {
                 residual,

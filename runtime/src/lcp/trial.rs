@@ -85,7 +85,7 @@ impl<T: RealField + Copy, const K: usize> Problem<T, K> {
     pub fn gather(
         W: &SMatrix<T, K, K>,
         b: &SVector<T, K>,
-        active: IndexSet,
+        active: IndexSet<K>,
         tolerance: T,
     ) -> Result<Self, LcpError<T>> {
         let mut problem = Self {
@@ -99,6 +99,12 @@ impl<T: RealField + Copy, const K: usize> Problem<T, K> {
             inv_diag: [T::zero(); K],
             tol_exact: T::zero(),
         };
+        if active.len() > super::Lcp::<T>::MAX_ACTIVE {
+            return Err(LcpError::ActiveSetTooLarge {
+                active: active.len(),
+                max: super::Lcp::<T>::MAX_ACTIVE,
+            });
+        }
         for i in active.iter() {
             if i >= K {
                 return Err(LcpError::IndexOutOfRange { index: i, dim: K });
@@ -161,7 +167,12 @@ impl<T: RealField + Copy, const K: usize> Problem<T, K> {
     /// All positions `{0, …, m − 1}`.
     #[inline]
     pub fn all(&self) -> u32 {
-        IndexSet::full(self.m).bits()
+        // m ≤ Lcp::MAX_ACTIVE = 32 (gather checks it)
+        if self.m == 0 {
+            0
+        } else {
+            u32::MAX >> (32 - self.m)
+        }
     }
 
     /// The first guess: `F₀ = {i : b_i < 0}` (the constraints that zero

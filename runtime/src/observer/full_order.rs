@@ -6,12 +6,13 @@ use crate::lcp::Lcp;
 use crate::linalg::SymmetricEigen;
 use crate::model::Model;
 
-use super::interval::{Interval, Memory, factor_mass, finite, saturate};
-use super::reduced_order::section_vii_impact;
+use super::interval::{Interval, Memory, saturate};
+use super::reduced_order::{restart_velocity, section_vii_impact};
 use super::{
-    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
-    check_restitution, check_vector,
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
+    UpdateReport, check_start,
 };
+use crate::validate::{self, factor_mass, finite_model};
 
 /// The gains `Λ` and `L_ρ1` of the full-order observer (36), both
 /// symmetric positive definite (`L_d = l_d I + Λ` and `L_ρ2 = l_d Λ` follow
@@ -40,7 +41,7 @@ impl<T: RealField + Copy, const N: usize> FullOrderGains<T, N> {
     /// positive definite.
     fn check(&self) -> Result<(), ObserverError<T>> {
         for (name, m) in [("lambda", &self.lambda), ("l_rho1", &self.l_rho1)] {
-            let bad = |value| ObserverError::InvalidParams { name, value };
+            let bad = |value| super::invalid(name, value);
             let asymmetry = (m - m.transpose()).amax();
             let tolerance = T::default_epsilon() * nalgebra::convert(1e3) * m.amax();
             if !asymmetry.is_finite() || asymmetry > tolerance {
@@ -117,6 +118,8 @@ pub struct FullOrder<T: RealField + Copy, const N: usize, const K: usize> {
     q_hat: SVector<T, N>,
     v: SVector<T, N>,
     report: UpdateReport<T, N, K>,
+    /// The outliers refused since the last accepted measurement.
+    outliers: Outliers<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
@@ -127,10 +130,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a setting out of its range or a
+    /// [`DataError::InvalidParams`](crate::DataError::InvalidParams) for a setting out of its range or a
     /// gain matrix that is not symmetric positive definite (`"lambda"`,
     /// `"l_rho1"`, with the offending eigenvalue),
-    /// [`ObserverError::NonFiniteMeasurement`] or
+    /// [`DataError::NonFinite`](crate::DataError::NonFinite) or
     /// [`ObserverError::InvalidTime`] for non-finite initial data.
     pub fn new(
         params: ObserverParams<T>,
@@ -141,11 +144,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ) -> Result<Self, ObserverError<T>> {
         params.check()?;
         gains.check()?;
-        if !t0.is_finite() {
-            return Err(ObserverError::InvalidTime { t: t0, last: t0 });
-        }
-        check_vector(&q0, "q0")?;
-        check_vector(&v0, "v0")?;
+        check_start(t0, &q0, &v0)?;
         Ok(Self {
             params,
             gains,
@@ -156,6 +155,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
             q_hat: q0,
             v: v0,
             report: UpdateReport::new(t0, T::zero()),
+            outliers: Outliers::NONE,
         })
     }
 
@@ -163,9 +163,9 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::NonFiniteMeasurement`] (`"q_hat0"`).
+    /// [`DataError::NonFinite`](crate::DataError::NonFinite) (`"q_hat0"`).
     pub fn with_position_estimate(self, q_hat: SVector<T, N>) -> Result<Self, ObserverError<T>> {
-        check_vector(&q_hat, "q_hat0")?;
+        validate::finite_vector(&q_hat, "q_hat0")?;
         Ok(Self { q_hat, ..self })
     }
 
@@ -174,10 +174,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidRestitution`] for a coefficient outside
+    /// [`DataError::InvalidRestitution`](crate::DataError::InvalidRestitution) for a coefficient outside
     /// `[0, 1]`.
     pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, ObserverError<T>> {
-        check_restitution(&restitution)?;
+        validate::restitution(&restitution)?;
         Ok(Self {
             restitution: Some(restitution),
             ..self
@@ -217,7 +217,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         M: Model<N, K, Scalar = T>,
     {
         let tau = interval.tau;
-        let (p_end, w_end) = interval.predict(&self.v, report)?;
+        let v0 = saturate(&self.v, self.params.velocity_bound);
+        let (p_end, w_end) = interval.predict(&v0, report)?;
         let innovation = interval.q1 - p_end;
         report.innovation = innovation;
         // the errors the samples reveal: q̃_k, and ṽ_k = ∫ṽ/τ = d/τ
@@ -262,7 +263,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
             interval.u,
         );
         report.evaluations += 1;
-        finite(&forces, "F")?;
+        finite_model(&forces, "F")?;
         let chol = factor_mass(&mass)?;
         let f2 = forces - (self.gains.l_rho1 + mass * lambda * l_d) * q_tilde;
         let z2_free = z2 - chol.solve(&f2) * tau;
@@ -270,6 +271,31 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         report.innovation = q1 - self.q - self.v * tau;
         let v = section_vii_impact(interval, &chol, &self.v, &v_free, report)?;
         Ok((z1_next, v))
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
+    /// The interval integrated by the chosen discretization, from `v̂_k`
+    /// held to `C_v`; `Err` names a restart when that failed from the
+    /// observer's own state.
+    fn integrate<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<(SVector<T, N>, SVector<T, N>), Restart>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let result = match self.params.scheme {
+            Discretization::ImpactAware => self.impact_aware(interval, report),
+            Discretization::SectionVii => self.section_vii(interval, report),
+        };
+        match result {
+            Ok((q_hat, v)) if q_hat.iter().chain(v.iter()).all(|x| x.is_finite()) => Ok((q_hat, v)),
+            // a failure from the observer's own state, or (no other error
+            // arises past the checks of `begin`) anything else
+            Ok(_) | Err(_) => Err(Restart::Infeasible),
+        }
     }
 }
 
@@ -366,14 +392,27 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for 
             restitution: self.restitution,
             report: &self.report,
         };
-        let (interval, mut report) = Interval::begin(model, u, memory, t, q)?;
-        let (q_hat, v) = match self.params.scheme {
-            Discretization::ImpactAware => self.impact_aware(&interval, &mut report)?,
-            Discretization::SectionVii => self.section_vii(&interval, &mut report)?,
+        let (interval, fresh) = Interval::begin(model, u, memory, t, q)?;
+        // SCREEN: an outlier is refused here, the estimate untouched
+        let plan = self
+            .outliers
+            .screen(&self.params, (t, interval.tau), &self.q, q)?;
+        let mut report = fresh;
+        let integrated = match plan {
+            Plan::Integrate => self.integrate(&interval, &mut report),
+            Plan::Restart(why) => Err(why),
         };
-        if !(q_hat.iter().chain(v.iter()).all(|x| x.is_finite())) {
-            return Err(ObserverError::NonFiniteResult);
-        }
+        let (q_hat, v) = match integrated {
+            Ok(estimate) => estimate,
+            Err(why) => {
+                report = fresh;
+                let v = restart_velocity(&interval, &self.v, why, &mut report)?;
+                (*q, v)
+            }
+        };
+        // WRITEBACK: the velocity estimate held to C_v, as in ReducedOrder
+        let v = saturate(&v, self.params.velocity_bound);
+        report.outliers = self.outliers.accept();
         (self.t, self.q, self.q_hat, self.v, self.report) = (t, *q, q_hat, v, report);
         Ok(self.estimate())
     }

@@ -41,8 +41,10 @@
 //!
 //! Corollary 2 (full order) asks `λ_min l_d > C_F + C_M C_v + β`,
 //! Corollary 3 (reduced order) `λ_min l_d ≥ 2 C_v C_M + 2 C_F + β`.
-//! [`ModelBounds::gain`] returns the `l_d` at which the condition holds
-//! with equality, [`ModelBounds::beta`] the margin `β` a given `l_d` leaves.
+//! [`ModelBounds::gain_for_margin`] returns the gain `l_d` at which the
+//! condition holds with equality, [`ModelBounds::margin`] the margin `β` a
+//! given `l_d` leaves; [`ModelBounds::gain_for_decay_rate`] the `l_d` of a
+//! decay rate (below). `β` is not a rate: the names keep the three apart.
 //!
 //! The paper's `β` is a margin in the units of `M` over time: with
 //! `W = ṽᵀ M ṽ`, the proof shows `dW/dt ≤ −2 l_d W + 2 (C_F + C_M C_v)|ṽ|²`
@@ -61,6 +63,7 @@
 
 use nalgebra::{RealField, SVector};
 
+use crate::error::DataError;
 use crate::linalg::{SymmetricEigen, spectral_norm};
 use crate::model::Model;
 
@@ -112,7 +115,7 @@ impl<T: RealField + Copy, const N: usize> GainRegion<T, N> {
     }
 
     fn check(&self) -> Result<(), ObserverError<T>> {
-        let bad = |name, value| Err(ObserverError::InvalidParams { name, value });
+        let bad = |name, value| Err(super::invalid(name, value));
         for i in 0..N {
             let (lo, hi) = (self.q_min[i], self.q_max[i]);
             if !(lo.is_finite() && hi.is_finite()) {
@@ -219,10 +222,13 @@ impl<T: RealField + Copy, const N: usize> GainRegion<T, N> {
 /// let region = GainRegion::new(Vector2::new(-1.0, -1.0), Vector2::new(1.0, 1.0), 5.0);
 /// let bounds = ModelBounds::estimate(&Puck { m: 2.0, b: 0.5 }, &region, &SVector::zeros())?;
 /// assert_eq!((bounds.mass_min, bounds.coriolis, bounds.force_lipschitz), (2.0, 0.0, 0.5));
-/// // Corollary 3 for β = 10: 2 l_d ≥ 2·0.5 + 10
-/// assert_eq!(bounds.gain(Design::ReducedOrder, 10.0), 5.5);
+/// // the gain for Corollary 3 with margin β = 10 kg/s: 2 l_d ≥ 2·0.5 + 10
+/// let l_d = bounds.gain_for_margin(Design::ReducedOrder, 10.0);
+/// assert_eq!(l_d, 5.5);
 /// // the velocity error of l_d = 5.5 decays at least like e^{-(5.5 - 0.5/2) t}
-/// assert_eq!(bounds.decay_rate(5.5), 5.25);
+/// assert_eq!(bounds.decay_rate(l_d), 5.25);
+/// // and the other way: the gain for a decay rate of 5.25 /s
+/// assert_eq!(bounds.gain_for_decay_rate(5.25), 5.5);
 /// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -250,11 +256,11 @@ impl<T: RealField + Copy> ModelBounds<T> {
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a region that is not a finite
-    /// box with `C_v > 0`, [`ObserverError::MassNotPositiveDefinite`] where
-    /// `M(q)` is not, [`ObserverError::NonFiniteModel`] where the model
-    /// evaluates to NaN, [`ObserverError::NonFiniteInput`] for a
-    /// non-finite `u`.
+    /// [`ObserverError::Data`] with [`DataError::InvalidParams`] for a
+    /// region that is not a finite box with `C_v > 0`,
+    /// [`DataError::MassNotPositiveDefinite`] where `M(q)` is not,
+    /// [`DataError::NonFiniteModel`] where the model evaluates to NaN,
+    /// [`DataError::NonFiniteInput`] for a non-finite `u`.
     pub fn estimate<M, const N: usize, const K: usize>(
         model: &M,
         region: &GainRegion<T, N>,
@@ -265,7 +271,7 @@ impl<T: RealField + Copy> ModelBounds<T> {
     {
         region.check()?;
         if let Some(index) = u.as_ref().iter().position(|x| !x.is_finite()) {
-            return Err(ObserverError::NonFiniteInput { index });
+            return Err(DataError::NonFiniteInput { index }.into());
         }
         let c_v = region.velocity_bound;
         let half: T = nalgebra::convert(0.5);
@@ -284,10 +290,10 @@ impl<T: RealField + Copy> ModelBounds<T> {
             let q = region.configuration(index);
             let mass = model.mass(&q);
             let eigen =
-                SymmetricEigen::new(&mass).ok_or(ObserverError::NonFiniteModel { which: "M" })?;
+                SymmetricEigen::new(&mass).ok_or(DataError::NonFiniteModel { which: "M" })?;
             // finite (the matrix was), so `≤ 0` is the whole test
             if eigen.min() <= T::zero() {
-                return Err(ObserverError::MassNotPositiveDefinite);
+                return Err(DataError::MassNotPositiveDefinite.into());
             }
             if first {
                 (bounds.mass_min, bounds.mass_max, first) = (eigen.min(), eigen.max(), false);
@@ -312,18 +318,27 @@ impl<T: RealField + Copy> ModelBounds<T> {
         Ok(bounds)
     }
 
-    /// The `l_d` at which `design`'s corollary holds with equality for the
-    /// margin `β`: `(C_F + C_M C_v + β)/λ_min` (Corollary 2; its strict
-    /// inequality holds for any larger `l_d`) or
-    /// `(2 C_v C_M + 2 C_F + β)/λ_min` (Corollary 3).
-    pub fn gain(&self, design: Design, beta: T) -> T {
+    /// The gain `l_d` (1/s) at which `design`'s corollary holds with
+    /// equality for the margin `β` (in the units of `M` per second, kg/s for
+    /// a mass; not a rate): `(C_F + C_M C_v + β)/λ_min` (Corollary 2; its
+    /// strict inequality holds for any larger `l_d`) or
+    /// `(2 C_v C_M + 2 C_F + β)/λ_min` (Corollary 3). For a decay rate, see
+    /// [`gain_for_decay_rate`](Self::gain_for_decay_rate).
+    pub fn gain_for_margin(&self, design: Design, beta: T) -> T {
         (self.coupling(design) + beta) / self.mass_min
     }
 
+    /// The gain `l_d` (1/s) whose guaranteed decay rate
+    /// ([`decay_rate`](Self::decay_rate)) is `rate` (1/s):
+    /// `rate + (C_F + C_M C_v)/λ_min`.
+    pub fn gain_for_decay_rate(&self, rate: T) -> T {
+        rate + self.coupling(Design::FullOrder) / self.mass_min
+    }
+
     /// The margin `β = λ_min l_d − (C_F + C_M C_v)` (Corollary 2) or
-    /// `λ_min l_d − 2 (C_v C_M + C_F)` (Corollary 3) that `l_d` leaves;
-    /// negative when `l_d` is too small for the corollary.
-    pub fn beta(&self, design: Design, l_d: T) -> T {
+    /// `λ_min l_d − 2 (C_v C_M + C_F)` (Corollary 3) that the gain `l_d`
+    /// leaves; negative when `l_d` is too small for the corollary.
+    pub fn margin(&self, design: Design, l_d: T) -> T {
         self.mass_min * l_d - self.coupling(design)
     }
 
@@ -350,7 +365,7 @@ fn norm<T: RealField + Copy, const N: usize>(
     m: &nalgebra::SMatrix<T, N, N>,
     which: &'static str,
 ) -> Result<T, ObserverError<T>> {
-    spectral_norm(m).ok_or(ObserverError::NonFiniteModel { which })
+    spectral_norm(m).ok_or(DataError::NonFiniteModel { which }.into())
 }
 
 /// The first 64 primes: the Halton bases.
@@ -381,77 +396,8 @@ fn radical_inverse(mut index: u64, base: u64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Linearization, ModelInfo};
-    use nalgebra::{Matrix2, SMatrix, Vector2};
-
-    /// A particle of mass `m` in polar coordinates `(r, θ)`, no potential:
-    /// `M = diag(m, m r²)`, `C = m r [[0, −θ̇], [θ̇, ṙ]]`, `F = C v` and
-    /// `∂F/∂v = 2C`.
-    struct Polar {
-        m: f64,
-    }
-
-    impl Model<2, 0> for Polar {
-        type Scalar = f64;
-        type Input = SVector<f64, 0>;
-        const INFO: ModelInfo<2, 0> = ModelInfo {
-            name: "Polar",
-            coordinates: ["r", "theta"],
-            velocities: ["dr", "dtheta"],
-            constraints: [],
-            parameters: &[],
-            inputs: &[],
-            source: "",
-            op_count: 0,
-        };
-        fn mass(&self, q: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::new(self.m, 0.0, 0.0, self.m * q[0] * q[0])
-        }
-        fn coriolis(&self, q: &Vector2<f64>, v: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::new(0.0, -v[1], v[1], v[0]) * (self.m * q[0])
-        }
-        fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> {
-            Vector2::zeros()
-        }
-        fn forces(
-            &self,
-            _: f64,
-            q: &Vector2<f64>,
-            v: &Vector2<f64>,
-            _: &SVector<f64, 0>,
-        ) -> Vector2<f64> {
-            self.coriolis(q, v) * v
-        }
-        fn gaps(&self, _: &Vector2<f64>) -> SVector<f64, 0> {
-            SVector::zeros()
-        }
-        fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 0, 2> {
-            SMatrix::zeros()
-        }
-        fn restitution(&self) -> SVector<f64, 0> {
-            SVector::zeros()
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
-            None
-        }
-        fn linearization(
-            &self,
-            t: f64,
-            q: &Vector2<f64>,
-            v: &Vector2<f64>,
-            u: &SVector<f64, 0>,
-        ) -> Linearization<f64, 2> {
-            Linearization {
-                mass: self.mass(q),
-                forces: self.forces(t, q, v, u),
-                forces_dq: Matrix2::zeros(),
-                forces_dv: self.coriolis(q, v) * 2.0,
-            }
-        }
-    }
+    use crate::testing::Polar;
+    use nalgebra::Vector2;
 
     /// The sup over unit `(ṙ, θ̇)` of `‖[[0, −θ̇], [θ̇, ṙ]]‖₂`: with
     /// `y = θ̇²`, `σ² = (1 + y + √(1 + 2y − 3y²))/2`, largest at `y = 2/3`,
@@ -478,10 +424,10 @@ mod tests {
         assert!(b.force_lipschitz >= c_f * (1.0 - 1e-3));
         assert_eq!(b.configurations, 4 + 1 + 512);
         // the corollaries, both ways
-        let l_d = b.gain(Design::ReducedOrder, 1.0);
-        assert!((b.beta(Design::ReducedOrder, l_d) - 1.0).abs() < 1e-12);
-        let l_d = b.gain(Design::FullOrder, 1.0);
-        assert!((b.beta(Design::FullOrder, l_d) - 1.0).abs() < 1e-12);
+        let l_d = b.gain_for_margin(Design::ReducedOrder, 1.0);
+        assert!((b.margin(Design::ReducedOrder, l_d) - 1.0).abs() < 1e-12);
+        let l_d = b.gain_for_margin(Design::FullOrder, 1.0);
+        assert!((b.margin(Design::FullOrder, l_d) - 1.0).abs() < 1e-12);
         // r = β₂ / λ_min
         assert!((b.decay_rate(l_d) - 1.0 / b.mass_min).abs() < 1e-12);
     }
@@ -515,15 +461,18 @@ mod tests {
         let region = GainRegion::new(Vector2::new(1.0, 0.0), Vector2::new(0.5, 1.0), 2.0);
         assert!(matches!(
             ModelBounds::estimate(&model, &region, &u),
-            Err(ObserverError::InvalidParams { name: "q_min", .. })
+            Err(ObserverError::Data(DataError::InvalidParams {
+                name: "q_min",
+                ..
+            }))
         ));
         let region = GainRegion::new(Vector2::new(0.5, 0.0), Vector2::new(1.0, 1.0), 0.0);
         assert!(matches!(
             ModelBounds::estimate(&model, &region, &u),
-            Err(ObserverError::InvalidParams {
+            Err(ObserverError::Data(DataError::InvalidParams {
                 name: "velocity_bound",
                 ..
-            })
+            }))
         ));
         let region = GainRegion::new(Vector2::new(f64::NAN, 0.0), Vector2::new(1.0, 1.0), 1.0);
         assert!(ModelBounds::estimate(&model, &region, &u).is_err());
@@ -531,7 +480,7 @@ mod tests {
         let region = GainRegion::new(Vector2::new(0.0, 0.0), Vector2::new(1.0, 1.0), 1.0);
         assert_eq!(
             ModelBounds::estimate(&model, &region, &u),
-            Err(ObserverError::MassNotPositiveDefinite)
+            Err(ObserverError::Data(DataError::MassNotPositiveDefinite))
         );
     }
 }

@@ -11,7 +11,8 @@ use crate::lcp::{IndexSet, Lcp};
 use crate::linalg::Cholesky;
 use crate::model::Model;
 
-use super::{ObserverError, ObserverParams, UpdateReport, check_restitution, check_update};
+use super::{ObserverError, ObserverParams, UpdateReport, check_update};
+use crate::validate::{self, factor_mass, finite_model as finite};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
@@ -32,32 +33,33 @@ pub(crate) fn injection_gain<T: RealField + Copy>(l_d: T, tau: T) -> T {
     -(-(l_d * tau)).exp_m1() / tau
 }
 
-/// Rejects a non-finite matrix, naming the model term.
-pub(crate) fn finite<T: RealField + Copy, const R: usize, const C: usize>(
-    m: &SMatrix<T, R, C>,
-    which: &'static str,
-) -> Result<(), T> {
-    if m.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ObserverError::NonFiniteModel { which })
-    }
-}
-
-/// Factors `M`, rejecting a non-finite or indefinite one.
-pub(crate) fn factor_mass<T: RealField + Copy, const N: usize>(
-    mass: &SMatrix<T, N, N>,
-) -> Result<Cholesky<T, N>, T> {
-    finite(mass, "M")?;
-    Cholesky::new(mass).ok_or(ObserverError::MassNotPositiveDefinite)
-}
-
 /// The mass matrix factored and the free acceleration `−M⁻¹ F̄` at one
 /// point of the predicted motion.
 #[derive(Clone, Copy)]
 pub(crate) struct Free<T: RealField + Copy, const N: usize> {
     pub chol: Cholesky<T, N>,
     pub accel: SVector<T, N>,
+}
+
+/// A point `(s, p, w)` of the predicted motion, with `M` factored and the
+/// free acceleration there.
+#[derive(Clone, Copy)]
+struct Point<'a, T: RealField + Copy, const N: usize> {
+    /// Local time `s`.
+    s: T,
+    p: &'a SVector<T, N>,
+    w: &'a SVector<T, N>,
+    free: &'a Free<T, N>,
+}
+
+/// Where Newton's law acts: local time `s`, the pre-impact velocity `w`,
+/// and `J`, `M` (factored) evaluated there.
+#[derive(Clone, Copy)]
+struct Contact<'a, T: RealField + Copy, const N: usize, const K: usize> {
+    s: T,
+    w: &'a SVector<T, N>,
+    jac: &'a SMatrix<T, K, N>,
+    chol: &'a Cholesky<T, N>,
 }
 
 /// The end of a piece of predicted motion, and the contact impulse
@@ -103,27 +105,27 @@ impl<T: RealField + Copy, const N: usize> Segment<T, N> {
 
 /// How each constraint stands at the start of a piece of motion.
 #[derive(Clone, Copy, Default)]
-struct Classes {
+struct Classes<const K: usize> {
     /// Open (`h_i` above the band): watched for a crossing.
-    free: IndexSet,
+    free: IndexSet<K>,
     /// Closed (within the band, or just reached).
-    contact: IndexSet,
+    contact: IndexSet<K>,
     /// Closed and approaching: Newton's law now.
-    approaching: IndexSet,
+    approaching: IndexSet<K>,
     /// Approaching faster than the resting speed: `ê_i` applies.
-    elastic: IndexSet,
+    elastic: IndexSet<K>,
     /// Closed, normal speed within the resting speed: persistent contact.
-    sliding: IndexSet,
+    sliding: IndexSet<K>,
     /// Closed and separating: watched for a return.
-    departing: IndexSet,
+    departing: IndexSet<K>,
 }
 
 /// What the search along a piece of motion found first: these
 /// constraints close (or, for a departing one that never opened, turn
 /// back) at `at`, relative to the piece's start.
-struct Crossing<T> {
+struct Crossing<T, const K: usize> {
     at: T,
-    set: IndexSet,
+    set: IndexSet<K>,
 }
 
 /// One sampling interval: the model, the two measurements around it and
@@ -187,7 +189,7 @@ where
     ) -> Result<(Self, UpdateReport<T, N, K>), T> {
         let tau = check_update(model, memory.t, t, q, u)?;
         let restitution = memory.restitution.unwrap_or_else(|| model.restitution());
-        check_restitution(&restitution)?;
+        validate::restitution(&restitution)?;
         let gain = injection_gain(memory.params.l_d, tau);
         let interval = Interval {
             model,
@@ -213,20 +215,16 @@ where
     T: RealField + Copy,
     M: Model<N, K, Scalar = T>,
 {
-    /// Newton's law, `ê` on `elastic` and `0` on the rest of `set`, at
-    /// local time `s` (where `J` and `M` were evaluated) for the
-    /// pre-impact velocity `w`: returns `w⁺`.
-    #[allow(clippy::too_many_arguments)]
+    /// Newton's law at `at` ([`Contact`]), `ê` on `elastic` and `0` on
+    /// the rest of `set`: returns `w⁺`.
     fn newton(
         &self,
-        s: T,
-        w: &SVector<T, N>,
-        jac: &SMatrix<T, K, N>,
-        chol: &Cholesky<T, N>,
-        set: IndexSet,
-        elastic: IndexSet,
+        at: &Contact<'_, T, N, K>,
+        set: IndexSet<K>,
+        elastic: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<SVector<T, N>, T> {
+        let Contact { s, w, jac, chol } = *at;
         let jw = jac * w;
         let mut approach = SVector::<T, K>::zeros();
         for i in elastic {
@@ -255,7 +253,7 @@ where
         chol: &Cholesky<T, N>,
         w_free: &SVector<T, N>,
         approach: &SVector<T, K>,
-        set: IndexSet,
+        set: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<SVector<T, N>, T> {
         if set.is_empty() {
@@ -331,7 +329,7 @@ where
         &self,
         p: &SVector<T, N>,
         w: &SVector<T, N>,
-        sliding: IndexSet,
+        sliding: IndexSet<K>,
         free: &Free<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, K>), T> {
@@ -355,19 +353,21 @@ where
     }
 
     /// Classical fourth-order Runge–Kutta for `p' = w`, `w' = a(s, p, w)`
-    /// over `[s0, s0 + h]`, from the point whose free acceleration is
-    /// `first`.
-    #[allow(clippy::too_many_arguments)]
+    /// over `[s0, s0 + h]` from `start`, with the persistent contacts
+    /// `sliding` held.
     fn rk4(
         &self,
-        s0: T,
-        p0: &SVector<T, N>,
-        w0: &SVector<T, N>,
+        start: &Point<'_, T, N>,
         h: T,
-        sliding: IndexSet,
-        first: &Free<T, N>,
+        sliding: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Arc<T, N, K>, T> {
+        let Point {
+            s: s0,
+            p: p0,
+            w: w0,
+            free: first,
+        } = *start;
         let half = h * nalgebra::convert::<f64, T>(0.5);
         let two: T = nalgebra::convert(2.0);
         let (k1, l1) = self.constrained(p0, w0, sliding, first, report)?;
@@ -418,24 +418,21 @@ where
     /// restitution only when it approaches faster than
     /// `v_rest,i + g_i u`, with `u` the estimate's [`uncertainty`](Self::uncertainty):
     /// slower, it is closed plastically.
-    #[allow(clippy::too_many_arguments)]
     fn classify(
         &self,
-        p: &SVector<T, N>,
-        h: &SVector<T, K>,
-        jac: &SMatrix<T, K, N>,
-        w: &SVector<T, N>,
-        accel: &SVector<T, N>,
-        resolved: IndexSet,
-        touched: IndexSet,
-    ) -> Result<Classes, T> {
+        at: &Point<'_, T, N>,
+        (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
+        resolved: IndexSet<K>,
+        touched: IndexSet<K>,
+    ) -> Result<Classes<K>, T> {
+        let (p, w, accel) = (at.p, at.w, &at.free.accel);
         let mut c = Classes::default();
         let band = self.params.contact_band();
         let noise_speed = self.noise_speed();
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
         let four: T = nalgebra::convert(4.0);
-        let mut closed = IndexSet::EMPTY;
-        for i in 0..K.min(IndexSet::CAPACITY) {
+        let mut closed = IndexSet::<K>::EMPTY;
+        for i in 0..K {
             let g = jac.row(i).norm();
             if h[i] <= g * band || touched.contains(i) {
                 closed.insert(i);
@@ -559,15 +556,15 @@ where
     fn first_crossing(
         &self,
         seg: &Segment<T, N>,
-        c: &Classes,
+        c: &Classes<K>,
         bands: &SVector<T, K>,
         start: (&SVector<T, K>, &SVector<T, K>),
         end: (&SVector<T, K>, &SVector<T, K>),
-    ) -> Result<Option<Crossing<T>>, T> {
+    ) -> Result<Option<Crossing<T, K>>, T> {
         let (h0, rate0) = start;
         let (h1, rate1) = end;
         let zero = T::zero();
-        let mut best: Option<(T, IndexSet)> = None;
+        let mut best: Option<(T, IndexSet<K>)> = None;
         let tol = T::default_epsilon() * nalgebra::convert(1024.0) * self.tau;
         let mut record = |at: T, i: usize| match &mut best {
             Some((s, set)) if (at - *s).abs() <= tol => {
@@ -630,7 +627,13 @@ where
             // CLASSIFY at (s, p, w)
             let free = self.free(s, &p, &w, report)?;
             let (h, jac) = self.contact(&p)?;
-            let c = self.classify(&p, &h, &jac, &w, &free.accel, resolved, touched)?;
+            let point = Point {
+                s,
+                p: &p,
+                w: &w,
+                free: &free,
+            };
+            let c = self.classify(&point, (&h, &jac), resolved, touched)?;
             // IMPACT now, on the closed constraints met approaching
             if !c.approaching.is_empty() && !last_round {
                 let elastic = if report.impacts < max_impacts {
@@ -638,7 +641,13 @@ where
                 } else {
                     IndexSet::EMPTY
                 };
-                w = self.newton(s, &w, &jac, &free.chol, c.contact, elastic, report)?;
+                let at = Contact {
+                    s,
+                    w: &w,
+                    jac: &jac,
+                    chol: &free.chol,
+                };
+                w = self.newton(&at, c.contact, elastic, report)?;
                 resolved = resolved.union(c.approaching);
                 touched = touched.union(c.approaching);
                 continue;
@@ -648,7 +657,7 @@ where
             if rest <= T::zero() {
                 return Ok((p, w));
             }
-            let arc = self.rk4(s, &p, &w, rest, c.sliding, &free, report)?;
+            let arc = self.rk4(&point, rest, c.sliding, report)?;
             report.contacts = report.contacts.union(c.sliding);
             // SEARCH for the first closing constraint along it
             if !last_round && report.impacts < max_impacts {
@@ -667,7 +676,7 @@ where
                 if let Some(Crossing { at, set }) =
                     self.first_crossing(&seg, &c, &bands, (&h, &rate0), (&h1, &rate1))?
                 {
-                    let part = self.rk4(s, &p, &w, at, c.sliding, &free, report)?;
+                    let part = self.rk4(&point, at, c.sliding, report)?;
                     report.impulses += part.impulse;
                     (s, p, w) = (s + at, part.p, part.w);
                     (resolved, touched) = (IndexSet::EMPTY, set);
@@ -690,7 +699,7 @@ where
         let (h, jac) = self.contact(&self.q1)?;
         let band = self.params.contact_band();
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * v.norm();
-        let approaching = (0..K.min(IndexSet::CAPACITY)).any(|i| {
+        let approaching = (0..K).any(|i| {
             let row = jac.row(i);
             h[i] <= row.norm() * band && row.dot(&v.transpose()) < -roundoff * row.norm()
         });
@@ -698,15 +707,19 @@ where
             return Ok(*v);
         }
         let free = self.free(self.tau, &self.q1, v, report)?;
-        let c = self.classify(
-            &self.q1,
-            &h,
-            &jac,
-            v,
-            &free.accel,
-            IndexSet::EMPTY,
-            IndexSet::EMPTY,
-        )?;
-        self.newton(self.tau, v, &jac, &free.chol, c.contact, c.elastic, report)
+        let point = Point {
+            s: self.tau,
+            p: &self.q1,
+            w: v,
+            free: &free,
+        };
+        let c = self.classify(&point, (&h, &jac), IndexSet::EMPTY, IndexSet::EMPTY)?;
+        let at = Contact {
+            s: self.tau,
+            w: v,
+            jac: &jac,
+            chol: &free.chol,
+        };
+        self.newton(&at, c.contact, c.elastic, report)
     }
 }

@@ -78,6 +78,27 @@ pub struct ObserverParams<T> {
     pub max_impacts: u32,
     /// The discretization (default [`Discretization::ImpactAware`]).
     pub scheme: Discretization,
+    /// Outlier factor `κ ≥ 1` (default `2`; `+∞` accepts every sample): a
+    /// measurement farther from the last accepted one than
+    /// [`outlier_bound`](Self::outlier_bound)`(τ) = κ (C_v τ + 2 √N n_σ σ)`,
+    /// more than a system slower than `C_v` moves in `τ` plus twice the
+    /// noise band, is not a position of the system: the update is refused
+    /// with [`ObserverError::Outlier`](super::ObserverError::Outlier) and
+    /// the estimate kept (see "Bad samples, bad states, long gaps" in the
+    /// module docs of `runtime/src/observer/mod.rs`).
+    pub outlier_factor: T,
+    /// Consecutive outliers refused before the next one restarts the
+    /// estimate from the measurement instead (default `3`): samples that
+    /// keep disagreeing with the estimate say that the estimate, not the
+    /// samples, is wrong.
+    pub max_outliers: u32,
+    /// Longest sampling interval integrated (default `3 / l_d`, three time
+    /// constants of the injection; `+∞` integrates every interval): over a
+    /// longer gap the prediction is an extrapolation, and the update
+    /// restarts instead from the measurement with the mean velocity over
+    /// the gap, held to `C_v`, and says so in its report
+    /// ([`UpdateReport::restart`](super::UpdateReport::restart)).
+    pub max_interval: T,
 }
 
 impl<T: RealField + Copy> ObserverParams<T> {
@@ -94,6 +115,9 @@ impl<T: RealField + Copy> ObserverParams<T> {
             rest_factor: nalgebra::convert(0.1),
             max_impacts: 16,
             scheme: Discretization::ImpactAware,
+            outlier_factor: nalgebra::convert(2.0),
+            max_outliers: 3,
+            max_interval: nalgebra::convert::<f64, T>(3.0) / l_d,
         }
     }
 
@@ -109,6 +133,102 @@ impl<T: RealField + Copy> ObserverParams<T> {
         Self { scheme, ..self }
     }
 
+    /// The same settings with the injection gain `l_d` (see
+    /// [`l_d`](Self::l_d); `max_interval` is left as it was).
+    #[must_use]
+    pub fn with_l_d(self, l_d: T) -> Self {
+        Self { l_d, ..self }
+    }
+
+    /// The same settings with the velocity bound `C_v` (see
+    /// [`velocity_bound`](Self::velocity_bound)).
+    #[must_use]
+    pub fn with_velocity_bound(self, velocity_bound: T) -> Self {
+        Self {
+            velocity_bound,
+            ..self
+        }
+    }
+
+    /// The same settings with `n_σ` (see [`noise_sigmas`](Self::noise_sigmas)).
+    #[must_use]
+    pub fn with_noise_sigmas(self, noise_sigmas: T) -> Self {
+        Self {
+            noise_sigmas,
+            ..self
+        }
+    }
+
+    /// The same settings with this contact distance (see
+    /// [`contact_distance`](Self::contact_distance)).
+    #[must_use]
+    pub fn with_contact_distance(self, contact_distance: T) -> Self {
+        Self {
+            contact_distance,
+            ..self
+        }
+    }
+
+    /// The same settings with this resting-speed factor (see
+    /// [`rest_factor`](Self::rest_factor)).
+    #[must_use]
+    pub fn with_rest_factor(self, rest_factor: T) -> Self {
+        Self {
+            rest_factor,
+            ..self
+        }
+    }
+
+    /// The same settings with at most this many impacts per interval (see
+    /// [`max_impacts`](Self::max_impacts)).
+    #[must_use]
+    pub fn with_max_impacts(self, max_impacts: u32) -> Self {
+        Self {
+            max_impacts,
+            ..self
+        }
+    }
+
+    /// The same settings with this outlier factor (see
+    /// [`outlier_factor`](Self::outlier_factor)).
+    #[must_use]
+    pub fn with_outlier_factor(self, outlier_factor: T) -> Self {
+        Self {
+            outlier_factor,
+            ..self
+        }
+    }
+
+    /// The same settings with this many outliers in a row before a restart
+    /// (see [`max_outliers`](Self::max_outliers)).
+    #[must_use]
+    pub fn with_max_outliers(self, max_outliers: u32) -> Self {
+        Self {
+            max_outliers,
+            ..self
+        }
+    }
+
+    /// The same settings with the longest interval integrated (see
+    /// [`max_interval`](Self::max_interval)).
+    #[must_use]
+    pub fn with_max_interval(self, max_interval: T) -> Self {
+        Self {
+            max_interval,
+            ..self
+        }
+    }
+
+    /// The largest distance `κ (C_v τ + 2 √N n_σ σ)` between two samples
+    /// `τ` apart that is not an outlier (see
+    /// [`outlier_factor`](Self::outlier_factor)).
+    pub fn outlier_bound(&self, tau: T, n: usize) -> T {
+        let two: T = nalgebra::convert(2.0);
+        let root_n = nalgebra::convert::<f64, T>(n as f64).sqrt();
+        self.outlier_factor
+            * (self.velocity_bound * tau + two * root_n * self.noise_sigmas * self.noise)
+    }
+
     /// The distance band of the contact rule, `contact_distance +
     /// noise_sigmas · noise`, in units of `q`.
     pub fn contact_band(&self) -> T {
@@ -116,10 +236,10 @@ impl<T: RealField + Copy> ObserverParams<T> {
     }
 
     /// Checks every setting: `l_d > 0`, `C_v > 0`, `σ, n_σ, d, ρ ≥ 0`, all
-    /// finite.
+    /// finite; `κ ≥ 1` and `max_interval > 0` (either may be `+∞`).
     pub(crate) fn check(&self) -> Result<(), super::ObserverError<T>> {
         let zero = T::zero();
-        let bad = |name, value| Err(super::ObserverError::InvalidParams { name, value });
+        let bad = |name, value| Err(super::invalid(name, value));
         let positive = [("l_d", self.l_d), ("velocity_bound", self.velocity_bound)];
         for (name, value) in positive {
             if !(value > zero && value.is_finite()) {
@@ -136,6 +256,16 @@ impl<T: RealField + Copy> ObserverParams<T> {
             if !(value >= zero && value.is_finite()) {
                 return bad(name, value);
             }
+        }
+        // +∞ allowed: it turns the test off
+        let (k, m) = (self.outlier_factor, self.max_interval);
+        #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN fails too
+        if !(k >= T::one()) {
+            return bad("outlier_factor", k);
+        }
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(m > zero) {
+            return bad("max_interval", m);
         }
         Ok(())
     }

@@ -6,11 +6,13 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Interval, Memory, factor_mass, finite, saturate};
+use super::interval::{Interval, Memory, saturate};
 use super::{
-    Discretization, Estimate, Observer, ObserverError, ObserverParams, UpdateReport,
-    check_restitution, check_vector,
+    Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
+    UpdateReport, check_start,
 };
+use crate::error::DataError;
+use crate::validate::{self, factor_mass, finite_model};
 
 /// The reduced-order velocity observer (38): `q̂ = q`, and
 ///
@@ -73,6 +75,8 @@ pub struct ReducedOrder<T: RealField + Copy, const N: usize, const K: usize> {
     q: SVector<T, N>,
     v: SVector<T, N>,
     report: UpdateReport<T, N, K>,
+    /// The outliers refused since the last accepted measurement.
+    outliers: Outliers<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
@@ -81,8 +85,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a setting out of its range,
-    /// [`ObserverError::NonFiniteMeasurement`] (`"q0"`, `"v0"`) or
+    /// [`DataError::InvalidParams`] for a setting out of its range,
+    /// [`DataError::NonFinite`] (`"q0"`, `"v0"`) or
     /// [`ObserverError::InvalidTime`] for non-finite initial data.
     pub fn new(
         params: ObserverParams<T>,
@@ -91,11 +95,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         v0: SVector<T, N>,
     ) -> Result<Self, ObserverError<T>> {
         params.check()?;
-        if !t0.is_finite() {
-            return Err(ObserverError::InvalidTime { t: t0, last: t0 });
-        }
-        check_vector(&q0, "q0")?;
-        check_vector(&v0, "v0")?;
+        check_start(t0, &q0, &v0)?;
         Ok(Self {
             params,
             restitution: None,
@@ -104,6 +104,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
             q: q0,
             v: v0,
             report: UpdateReport::new(t0, T::zero()),
+            outliers: Outliers::NONE,
         })
     }
 
@@ -112,10 +113,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidRestitution`] for a coefficient outside
+    /// [`DataError::InvalidRestitution`] for a coefficient outside
     /// `[0, 1]`.
     pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, ObserverError<T>> {
-        check_restitution(&restitution)?;
+        validate::restitution(&restitution)?;
         Ok(Self {
             restitution: Some(restitution),
             ..self
@@ -153,11 +154,94 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
             interval.u,
         );
         report.evaluations += 1;
-        finite(&forces, "F")?;
+        finite_model(&forces, "F")?;
         let chol = factor_mass(&mass)?;
         let v_free = v_pre - chol.solve(&forces) * tau - v_pre * (tau * l_d);
         report.innovation = q1 - self.q - self.v * tau;
         section_vii_impact(interval, &chol, &self.v, &v_free, report)
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
+    /// The interval integrated by the chosen discretization, from `v̂_k`
+    /// held to `C_v`; `Err` names a restart when that failed from the
+    /// observer's own state.
+    fn integrate<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, Restart>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let v0 = saturate(&self.v, self.params.velocity_bound);
+        let result = match self.params.scheme {
+            Discretization::ImpactAware => (|| {
+                // PREDICT from (q_k, v̂_k), impacts inside the interval
+                let (p_end, w_end) = interval.predict(&v0, report)?;
+                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
+                // displacement, integrated exactly over τ
+                let innovation = interval.q1 - p_end;
+                report.innovation = innovation;
+                let v = w_end + innovation * interval.gain;
+                // CLOSE: v̂_e ∈ V(q_{k+1})
+                interval.close_at_end(&v, report)
+            })(),
+            Discretization::SectionVii => self.section_vii(interval, report),
+        };
+        match result {
+            Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(v),
+            // a failure from the observer's own state, or (no other error
+            // arises past the checks of `begin`) anything else
+            Ok(_) | Err(_) => Err(Restart::Infeasible),
+        }
+    }
+
+    /// The estimate restarted from the measurement `q_{k+1}`: `v̂_k` kept
+    /// after outliers, else the mean velocity over the interval, held to
+    /// `C_v`, then Newton's law at `q_{k+1}` for the closed constraints it
+    /// approaches.
+    fn restart<M>(
+        &self,
+        interval: &Interval<'_, M, T, N, K>,
+        why: Restart,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, ObserverError<T>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        restart_velocity(interval, &self.v, why, report)
+    }
+}
+
+/// The velocity a restart starts from (see [`Restart`]), closed at the
+/// measurement; the report records the restart and, as its innovation, the
+/// displacement the old estimate did not explain (so the next update
+/// treats the estimate as uncertain).
+pub(crate) fn restart_velocity<M, T, const N: usize, const K: usize>(
+    interval: &Interval<'_, M, T, N, K>,
+    v_k: &SVector<T, N>,
+    why: Restart,
+    report: &mut UpdateReport<T, N, K>,
+) -> Result<SVector<T, N>, ObserverError<T>>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    let bound = interval.params.velocity_bound;
+    let displacement = interval.q1 - interval.q0;
+    let v = match why {
+        Restart::Outliers => *v_k,
+        Restart::LongInterval | Restart::Infeasible => displacement / interval.tau,
+    };
+    let v = saturate(&v, bound);
+    report.restart = Some(why);
+    report.innovation = displacement - saturate(v_k, bound) * interval.tau;
+    let v = interval.close_at_end(&v, report)?;
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(DataError::NonFiniteResult.into())
     }
 }
 
@@ -179,7 +263,7 @@ where
     let (h1, jac) = interval.contact(&interval.q1)?;
     let band = interval.params.contact_band();
     let mut set = IndexSet::new();
-    for i in 0..K.min(IndexSet::CAPACITY) {
+    for i in 0..K {
         let g = jac.row(i).norm() * band;
         if h0[i] <= g || h1[i] <= g {
             set.insert(i);
@@ -220,25 +304,27 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
             restitution: self.restitution,
             report: &self.report,
         };
-        let (interval, mut report) = Interval::begin(model, u, memory, t, q)?;
-        let v = match self.params.scheme {
-            Discretization::ImpactAware => {
-                // PREDICT from (q_k, v̂_k), impacts inside the interval
-                let (p_end, w_end) = interval.predict(&self.v, &mut report)?;
-                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
-                // displacement, integrated exactly over τ
-                let innovation = q - p_end;
-                report.innovation = innovation;
-                let v = w_end + innovation * interval.gain;
-                // CLOSE: v̂_e ∈ V(q_{k+1})
-                interval.close_at_end(&v, &mut report)?
-            }
-            Discretization::SectionVii => self.section_vii(&interval, &mut report)?,
+        let (interval, fresh) = Interval::begin(model, u, memory, t, q)?;
+        // SCREEN: an outlier is refused here, the estimate untouched
+        let plan = self
+            .outliers
+            .screen(&self.params, (t, interval.tau), &self.q, q)?;
+        let mut report = fresh;
+        let integrated = match plan {
+            Plan::Integrate => self.integrate(&interval, &mut report),
+            Plan::Restart(why) => Err(why),
         };
-        // WRITEBACK: only a finite estimate replaces the state
-        if !v.iter().all(|x| x.is_finite()) {
-            return Err(ObserverError::NonFiniteResult);
-        }
+        let v = match integrated {
+            Ok(v) => v,
+            Err(why) => {
+                report = fresh;
+                self.restart(&interval, why, &mut report)?
+            }
+        };
+        // WRITEBACK: the estimate held to C_v (a radial projection onto a
+        // ball that holds the true velocity never moves it away from it)
+        let v = saturate(&v, self.params.velocity_bound);
+        report.outliers = self.outliers.accept();
         (self.t, self.q, self.v, self.report) = (t, *q, v, report);
         Ok(self.estimate())
     }
@@ -263,84 +349,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ModelInfo;
-    use nalgebra::{Matrix1, Matrix2, SMatrix, Vector1, Vector2};
-
-    /// A ball of unit mass above the floor `y ≥ 0`, gravity `g`,
-    /// restitution `e`.
-    struct Ball {
-        g: f64,
-        e: f64,
-    }
-
-    impl Model<1, 1> for Ball {
-        type Scalar = f64;
-        type Input = SVector<f64, 0>;
-        const INFO: ModelInfo<1, 1> = ModelInfo {
-            name: "Ball",
-            coordinates: ["y"],
-            velocities: ["vy"],
-            constraints: ["floor"],
-            parameters: &[],
-            inputs: &[],
-            source: "",
-            op_count: 0,
-        };
-        fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> {
-            Matrix1::new(1.0)
-        }
-        fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> {
-            Matrix1::zeros()
-        }
-        fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> {
-            Vector1::new(self.g)
-        }
-        fn forces(
-            &self,
-            _: f64,
-            q: &Vector1<f64>,
-            _: &Vector1<f64>,
-            _: &SVector<f64, 0>,
-        ) -> Vector1<f64> {
-            self.gravity(q)
-        }
-        fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> {
-            *q
-        }
-        fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> {
-            Matrix1::new(1.0)
-        }
-        fn restitution(&self) -> Vector1<f64> {
-            Vector1::new(self.e)
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
-            None
-        }
-    }
-
-    /// The exact bouncing ball dropped from rest at `y0`: `(y, v)` at `t`
-    /// (right limits), and the impact times.
-    fn exact_ball(g: f64, e: f64, y0: f64, t: f64) -> (f64, f64, Vec<f64>) {
-        let mut impacts = Vec::new();
-        let mut t_impact = (2.0 * y0 / g).sqrt();
-        if t < t_impact {
-            return (y0 - 0.5 * g * t * t, -g * t, impacts);
-        }
-        let mut up = e * g * t_impact;
-        loop {
-            impacts.push(t_impact);
-            let flight = 2.0 * up / g;
-            if t < t_impact + flight {
-                let s = t - t_impact;
-                return (up * s - 0.5 * g * s * s, up - g * s, impacts);
-            }
-            t_impact += flight;
-            up *= e;
-        }
-    }
+    use crate::testing::{Ball, Puck, exact_ball};
+    use nalgebra::{Vector1, Vector2};
 
     /// On exact samples of a bouncing ball (analytic, not made by any time
     /// stepper) with the exact initial velocity, the impact-aware observer
@@ -452,60 +462,6 @@ mod tests {
         assert!(rms < 3.0 * 10.0 * sigma, "{rms}");
     }
 
-    /// A puck of unit mass on the floor `y ≥ 0`, pressed by gravity and
-    /// pushed along by a constant force `f`.
-    struct Puck {
-        f: f64,
-    }
-
-    impl Model<2, 1> for Puck {
-        type Scalar = f64;
-        type Input = SVector<f64, 0>;
-        const INFO: ModelInfo<2, 1> = ModelInfo {
-            name: "Puck",
-            coordinates: ["x", "y"],
-            velocities: ["vx", "vy"],
-            constraints: ["floor"],
-            parameters: &[],
-            inputs: &[],
-            source: "",
-            op_count: 0,
-        };
-        fn mass(&self, _: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::identity()
-        }
-        fn coriolis(&self, _: &Vector2<f64>, _: &Vector2<f64>) -> Matrix2<f64> {
-            Matrix2::zeros()
-        }
-        fn gravity(&self, _: &Vector2<f64>) -> Vector2<f64> {
-            Vector2::new(0.0, 9.81)
-        }
-        fn forces(
-            &self,
-            _: f64,
-            q: &Vector2<f64>,
-            _: &Vector2<f64>,
-            _: &SVector<f64, 0>,
-        ) -> Vector2<f64> {
-            self.gravity(q) - Vector2::new(self.f, 0.0)
-        }
-        fn gaps(&self, q: &Vector2<f64>) -> Vector1<f64> {
-            Vector1::new(q[1])
-        }
-        fn gap_jacobian(&self, _: &Vector2<f64>) -> SMatrix<f64, 1, 2> {
-            SMatrix::<f64, 1, 2>::new(0.0, 1.0)
-        }
-        fn restitution(&self) -> Vector1<f64> {
-            Vector1::new(0.9)
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> {
-            None
-        }
-    }
-
     /// Sliding: the contact force cancels the normal part of gravity, the
     /// estimate stays tangent, and the tangential error decays exactly like
     /// `e^{−l_d t}` (the contact does not disturb the injection).
@@ -532,45 +488,10 @@ mod tests {
     /// The observer is generic in the scalar: `f32` runs the same bounce.
     #[test]
     fn runs_in_f32() {
-        struct Ball32;
-        impl Model<1, 1> for Ball32 {
-            type Scalar = f32;
-            type Input = SVector<f32, 0>;
-            const INFO: ModelInfo<1, 1> = Ball::INFO;
-            fn mass(&self, _: &Vector1<f32>) -> Matrix1<f32> {
-                Matrix1::new(1.0)
-            }
-            fn coriolis(&self, _: &Vector1<f32>, _: &Vector1<f32>) -> Matrix1<f32> {
-                Matrix1::zeros()
-            }
-            fn gravity(&self, _: &Vector1<f32>) -> Vector1<f32> {
-                Vector1::new(9.81)
-            }
-            fn forces(
-                &self,
-                _: f32,
-                q: &Vector1<f32>,
-                _: &Vector1<f32>,
-                _: &SVector<f32, 0>,
-            ) -> Vector1<f32> {
-                self.gravity(q)
-            }
-            fn gaps(&self, q: &Vector1<f32>) -> Vector1<f32> {
-                *q
-            }
-            fn gap_jacobian(&self, _: &Vector1<f32>) -> Matrix1<f32> {
-                Matrix1::new(1.0)
-            }
-            fn restitution(&self) -> Vector1<f32> {
-                Vector1::new(0.8)
-            }
-            fn parameter(&self, _: usize) -> Option<f32> {
-                None
-            }
-            fn parameter_mut(&mut self, _: usize) -> Option<&mut f32> {
-                None
-            }
-        }
+        let ball = Ball {
+            g: 9.81_f32,
+            e: 0.8,
+        };
         let params = ObserverParams::new(10.0_f32, 20.0);
         let mut observer =
             ReducedOrder::<f32, 1, 1>::new(params, 0.0, Vector1::new(1.0), Vector1::zeros())
@@ -580,12 +501,7 @@ mod tests {
             let t = k as f64 * 1e-3;
             let (y, v, _) = exact_ball(9.81, 0.8, 1.0, t);
             let estimate = observer
-                .update(
-                    &Ball32,
-                    t as f32,
-                    &Vector1::new(y as f32),
-                    &SVector::zeros(),
-                )
+                .update(&ball, t as f32, &Vector1::new(y as f32), &SVector::zeros())
                 .unwrap();
             worst = worst.max((estimate.v[0] - v as f32).abs());
         }

@@ -24,12 +24,12 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     /// Time of the first impact in the interval, if any.
     pub first_impact: Option<T>,
     /// Constraints that received an impulse at an impact.
-    pub impacted: IndexSet,
+    pub impacted: IndexSet<K>,
     /// Constraints treated as persistent contacts during the interval (the
     /// mass sliding along them).
-    pub contacts: IndexSet,
+    pub contacts: IndexSet<K>,
     /// Every constraint that took part in a complementarity problem.
-    pub active: IndexSet,
+    pub active: IndexSet<K>,
     /// Sum over the interval of the multipliers per constraint: impulses `λ`
     /// of the impacts plus the integral `∫ λ dt` of the contact forces
     /// (momentum units, as `Jᵀλ`).
@@ -49,6 +49,31 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     pub gain: T,
     /// Evaluations of the model's dynamics `(M, F)`.
     pub evaluations: u32,
+    /// Measurements skipped as outliers between the previous accepted
+    /// update and this one.
+    pub outliers: u32,
+    /// `Some` when this update did not integrate the interval but restarted
+    /// the estimate from the measurement, and why.
+    pub restart: Option<Restart>,
+}
+
+/// Why an update restarted the estimate from the measurement (`q̂ = q`,
+/// `v̂` held to `C_v`) instead of integrating the interval (see "Bad
+/// samples, bad states, long gaps" in the module docs of
+/// `runtime/src/observer/mod.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Restart {
+    /// [`max_outliers`](super::ObserverParams::max_outliers) outliers in a
+    /// row: the estimate, not the samples, was off. `v̂` is kept.
+    Outliers,
+    /// The interval is longer than
+    /// [`max_interval`](super::ObserverParams::max_interval): `v̂` is the
+    /// mean velocity over it, an extrapolation.
+    LongInterval,
+    /// Integrating the interval from the observer's own state failed (the
+    /// model or an impact problem failed along the predicted motion): `v̂` is
+    /// the mean velocity over the interval.
+    Infeasible,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> UpdateReport<T, N, K> {
@@ -69,6 +94,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> UpdateReport<T, N, K> 
             innovation: SVector::zeros(),
             gain: T::zero(),
             evaluations: 0,
+            outliers: 0,
+            restart: None,
         }
     }
 

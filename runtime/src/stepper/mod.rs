@@ -123,27 +123,12 @@ pub use report::{Impact, StepReport};
 
 use nalgebra::{RealField, SMatrix, SVector};
 
+use crate::error::DataError;
 use crate::lcp::{IndexSet, Lcp};
 use crate::linalg::{Cholesky, Lu};
 use crate::model::Model;
-
-/// The state of a mechanical system at one time.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct State<T: RealField + Copy, const N: usize> {
-    /// Time `t`.
-    pub t: T,
-    /// Generalized coordinates `q`.
-    pub q: SVector<T, N>,
-    /// Generalized velocities `v` (right limits: post-impact values).
-    pub v: SVector<T, N>,
-}
-
-impl<T: RealField + Copy, const N: usize> State<T, N> {
-    /// The state `(t, q, v)`.
-    pub fn new(t: T, q: SVector<T, N>, v: SVector<T, N>) -> Self {
-        Self { t, q, v }
-    }
-}
+use crate::state::State;
+use crate::validate;
 
 /// The Moreau–Jean stepper: settings and nothing else.
 ///
@@ -197,7 +182,8 @@ impl<T: RealField + Copy> MoreauJean<T> {
     ///
     /// # Errors
     ///
-    /// [`StepError::InvalidParams`] when a setting is out of its range.
+    /// [`StepError::Data`] with [`DataError::InvalidParams`] when a setting is
+    /// out of its range.
     pub fn new(params: StepParams<T>) -> Result<Self, StepError<T>> {
         check_params(&params)?;
         Ok(Self {
@@ -220,6 +206,74 @@ impl<T: RealField + Copy> MoreauJean<T> {
     /// Advances `state` by one step `τ` under the known input `u`, and says
     /// what happened.
     ///
+    /// # Time
+    ///
+    /// When `state.t` is a multiple of `τ` (to a few rounding errors, as
+    /// from `t = 0`), the new time is the correctly rounded `(k + 1) τ`:
+    /// `t_k` never drifts from `kτ` by more than half a unit in the last
+    /// place, however long the run (no rounding error gathers from adding
+    /// `τ` at every step). From any other time, `t + τ`.
+    ///
+    /// A step is refused with [`StepError::TimeDoesNotAdvance`], before
+    /// anything changes, when the scalar type resolves `τ` at `t` too
+    /// coarsely to keep time (`16 ε |t| ≥ τ`, which includes `t + τ == t`;
+    /// past it, adding `τ` rounds by a large part of a step, and summed time
+    /// runs percents slow or fast): in `f32` with `τ = 1` ms that is from
+    /// `t ≈ 524` s on (`f64`: `2.8e11` s). To run
+    /// longer, keep `t` relative to an epoch that the caller moves: every
+    /// so often (a multiple of `τ`, say every 1000 s) subtract it from
+    /// `state.t` and add it to the epoch, which the caller holds in a wider
+    /// type (an integer count of steps or an `f64`); a model whose forces
+    /// depend on `t` then takes the epoch as a parameter or input.
+    ///
+    /// ```
+    /// use moreau_runtime::{Model, ModelInfo, MoreauJean, State, StepError, StepParams};
+    /// use nalgebra::{Matrix1, SVector, Vector1};
+    ///
+    /// /// A unit mass pulled by gravity, no constraint.
+    /// struct Fall;
+    /// impl Model<1, 0> for Fall {
+    ///     type Scalar = f32;
+    ///     type Input = SVector<f32, 0>;
+    ///     const INFO: ModelInfo<1, 0> = ModelInfo {
+    ///         name: "Fall", coordinates: ["y"], velocities: ["vy"], constraints: [],
+    ///         parameters: &[], inputs: &[], source: "", op_count: 0,
+    ///     };
+    ///     fn mass(&self, _: &Vector1<f32>) -> Matrix1<f32> { Matrix1::new(1.0) }
+    ///     fn coriolis(&self, _: &Vector1<f32>, _: &Vector1<f32>) -> Matrix1<f32> { Matrix1::zeros() }
+    ///     fn gravity(&self, _: &Vector1<f32>) -> Vector1<f32> { Vector1::new(9.81) }
+    ///     fn forces(&self, _: f32, q: &Vector1<f32>, _: &Vector1<f32>, _: &SVector<f32, 0>) -> Vector1<f32> {
+    ///         self.gravity(q)
+    ///     }
+    ///     fn gaps(&self, _: &Vector1<f32>) -> SVector<f32, 0> { SVector::zeros() }
+    ///     fn gap_jacobian(&self, _: &Vector1<f32>) -> nalgebra::SMatrix<f32, 0, 1> { nalgebra::SMatrix::zeros() }
+    ///     fn restitution(&self) -> SVector<f32, 0> { SVector::zeros() }
+    ///     fn parameter(&self, _: usize) -> Option<f32> { None }
+    ///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f32> { None }
+    /// }
+    ///
+    /// let stepper = MoreauJean::new(StepParams::new(1e-3_f32))?;
+    /// let u = SVector::zeros();
+    /// // at t = 32768 s, f32 cannot tell t + 1 ms from t: refused, unchanged
+    /// // (and so is every step from t = 524 s on)
+    /// let mut late = State::new(32768.0_f32, Vector1::new(0.0), Vector1::new(0.0));
+    /// let err = stepper.step(&Fall, &mut late, &u).unwrap_err();
+    /// assert!(matches!(err, StepError::TimeDoesNotAdvance { .. }));
+    /// assert_eq!(late.t, 32768.0);
+    /// // the same run on a moving epoch: whole seconds held in an integer
+    /// let (mut epoch_s, mut state) = (32768_u64, State::new(0.0_f32, Vector1::new(0.0), Vector1::new(0.0)));
+    /// for _ in 0..2500 {
+    ///     stepper.step(&Fall, &mut state, &u)?;
+    ///     if state.t >= 1.0 {
+    ///         state.t -= 1.0; // exact: t is (k τ) rounded, and 1 s = 1000 τ
+    ///         epoch_s += 1;
+    ///     }
+    /// }
+    /// assert_eq!(epoch_s, 32770);
+    /// assert!((state.t - 0.5).abs() < 1e-6);
+    /// # Ok::<(), StepError<f32>>(())
+    /// ```
+    ///
     /// # Errors
     ///
     /// A [`StepError`] naming the problem; `state` is then unchanged.
@@ -233,8 +287,9 @@ impl<T: RealField + Copy> MoreauJean<T> {
         M: Model<N, K, Scalar = T>,
     {
         check_inputs(model, state, u)?;
+        let t_next = self.next_time(state.t)?;
         // INDEX SET by γ-prediction, and what the step keeps from its start
-        let start = self.begin(model, state, u)?;
+        let start = self.begin(model, state, t_next, u)?;
         let mut report = StepReport::new(start.t_next, start.active);
         // NEWTON, from the first iterate (q_k + τ v_k, v_k)
         let mut iterate = (start.q + start.v * self.params.tau, start.v);
@@ -251,10 +306,40 @@ impl<T: RealField + Copy> MoreauJean<T> {
         // WRITEBACK: only a finite result replaces the caller's state
         let (q, v) = iterate;
         if !(q.iter().chain(v.iter()).all(|x| x.is_finite()) && start.t_next.is_finite()) {
-            return Err(StepError::NonFiniteResult);
+            return Err(DataError::NonFiniteResult.into());
         }
         *state = State::new(start.t_next, q, v);
         Ok(report)
+    }
+
+    /// The time at the end of a step from `t`: on the grid `kτ` when `t` is
+    /// on it (to a few rounding errors), so that a run from `t = 0` (or any
+    /// multiple of `τ`) keeps `t_k` the correctly rounded `kτ` however long
+    /// it runs, instead of gathering one rounding error per step; `t + τ`
+    /// otherwise.
+    ///
+    /// # Errors
+    ///
+    /// [`StepError::TimeDoesNotAdvance`] when the scalar type resolves `τ`
+    /// at `t` too coarsely to keep time: `16 ε |t| ≥ τ`, which includes
+    /// `t + τ == t`. Below it, the spacing of the numbers near `t` is under
+    /// `τ/16`, `t/τ` is within `0.1` of its integer `k`, and the grid is
+    /// found again at every step.
+    fn next_time(&self, t: T) -> Result<T, StepError<T>> {
+        let tau = self.params.tau;
+        let eps = T::default_epsilon();
+        // t is finite (checked) and τ positive: no NaN here
+        let sixteen: T = nalgebra::convert(16.0);
+        if sixteen * eps * t.abs() >= tau || t + tau == t {
+            return Err(StepError::TimeDoesNotAdvance { t, tau });
+        }
+        let k = (t / tau).round();
+        let four: T = nalgebra::convert(4.0);
+        if (t - k * tau).abs() <= four * eps * t.abs().max(tau) {
+            Ok((k + T::one()) * tau)
+        } else {
+            Ok(t + tau)
+        }
     }
 
     /// The start of a step: the index set by γ-prediction,
@@ -264,6 +349,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
         &self,
         model: &M,
         state: &State<T, N>,
+        t_next: T,
         u: &M::Input,
     ) -> Result<Start<T, N, K>, StepError<T>>
     where
@@ -278,7 +364,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
         finite_matrix(&forces, "F")?;
         Ok(Start {
             t,
-            t_next: t + self.params.tau,
+            t_next,
             q,
             v,
             normal_velocity,
@@ -430,7 +516,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
         jac: &SMatrix<T, K, N>,
         v_free: &SVector<T, N>,
         restitution_term: &SVector<T, K>,
-        active: IndexSet,
+        active: IndexSet<K>,
     ) -> Result<Impulse<T, N, K>, StepError<T>> {
         if active.is_empty() {
             return Ok(Impulse::none());
@@ -464,7 +550,7 @@ struct Start<T: RealField + Copy, const N: usize, const K: usize> {
     forces: SVector<T, N>,
     restitution: SVector<T, K>,
     /// The index set of the step.
-    active: IndexSet,
+    active: IndexSet<K>,
 }
 
 /// The outcome of one Newton iteration.
@@ -512,9 +598,9 @@ pub fn predict_index_set<T: RealField + Copy, const K: usize>(
     gaps: &SVector<T, K>,
     normal_velocity: &SVector<T, K>,
     gamma_tau: T,
-) -> IndexSet {
+) -> IndexSet<K> {
     let mut set = IndexSet::new();
-    for i in 0..K.min(IndexSet::CAPACITY) {
+    for i in 0..K {
         if gaps[i] + gamma_tau * normal_velocity[i] <= T::zero() {
             set.insert(i);
         }
@@ -591,12 +677,18 @@ fn update_position<T: RealField + Copy, const N: usize>(
 
 fn check_params<T: RealField + Copy>(p: &StepParams<T>) -> Result<(), StepError<T>> {
     let (zero, one) = (T::zero(), T::one());
-    let bad = |name, value| Err(StepError::InvalidParams { name, value });
+    let bad = |name, value| Err(DataError::InvalidParams { name, value }.into());
     if !(p.tau > zero && p.tau.is_finite()) {
         return bad("tau", p.tau);
     }
     if !(p.theta > zero && p.theta <= one) {
         return bad("theta", p.theta);
+    }
+    // a τ so small that τ²θ², the weight of ∂F/∂q in W, underflows to zero
+    // (τ = f64::MIN_POSITIVE) is out of range too
+    let h = p.tau * p.theta;
+    if h * h == zero {
+        return bad("tau", p.tau);
     }
     if !(p.gamma >= zero && p.gamma <= one) {
         return bad("gamma", p.gamma);
@@ -621,51 +713,28 @@ where
     T: RealField + Copy,
     M: Model<N, K, Scalar = T>,
 {
-    if !state.t.is_finite() {
-        return Err(StepError::NonFiniteState {
-            which: "t",
-            index: 0,
-        });
-    }
-    for (which, x) in [("q", &state.q), ("v", &state.v)] {
-        if let Some(index) = x.iter().position(|x| !x.is_finite()) {
-            return Err(StepError::NonFiniteState { which, index });
-        }
-    }
-    let mut index = 0;
-    while let Some(p) = model.parameter(index) {
-        if !p.is_finite() {
-            return Err(StepError::NonFiniteParameter { index });
-        }
-        index += 1;
-    }
-    if let Some(index) = u.as_ref().iter().position(|x| !x.is_finite()) {
-        return Err(StepError::NonFiniteInput { index });
-    }
-    let e = model.restitution();
-    for (constraint, &value) in e.iter().enumerate() {
-        if !(value >= T::zero() && value <= T::one()) {
-            return Err(StepError::InvalidRestitution { constraint, value });
-        }
-    }
+    let t = SVector::<T, 1>::new(state.t);
+    validate::finite_vector(&t, "t")?;
+    validate::finite_vector(&state.q, "q")?;
+    validate::finite_vector(&state.v, "v")?;
+    validate::model_and_input(model, u)?;
+    validate::restitution(&model.restitution())?;
     Ok(())
 }
 
-/// Checks that `M` is positive definite and returns its Cholesky factor.
+/// Checks that `M` is positive definite and returns its Cholesky factor
+/// (the shared check, [`validate::factor_mass`]).
 fn check_mass<T: RealField + Copy, const N: usize>(
     m: &SMatrix<T, N, N>,
 ) -> Result<Cholesky<T, N>, StepError<T>> {
-    finite_matrix(m, "M")?;
-    Cholesky::new(m).ok_or(StepError::MassNotPositiveDefinite)
+    Ok(validate::factor_mass(m)?)
 }
 
+/// Rejects a non-finite model term (the shared check,
+/// [`validate::finite_model`]).
 fn finite_matrix<T: RealField + Copy, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     which: &'static str,
 ) -> Result<(), StepError<T>> {
-    if m.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(StepError::NonFiniteModel { which })
-    }
+    Ok(validate::finite_model(m, which)?)
 }

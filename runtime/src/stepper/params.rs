@@ -4,11 +4,29 @@ use nalgebra::RealField;
 
 /// Settings of the Moreau–Jean θ-method ([`MoreauJean`](super::MoreauJean)).
 ///
-/// One `Copy` struct of knobs, each with its default and what moving it
-/// does. The defaults are Siconos' (`MoreauJeanOSI(0.5, 0.5)` in a
-/// `TimeStepping` with its default Newton loop) except for how Newton's law
-/// measures the approach velocity; with [`ApproachVelocity::Start`] the
-/// stepper does exactly what Siconos does.
+/// One `Copy` struct of knobs, each with its default, what moving it does,
+/// and a builder method (`with_…`). [`StepParams::new`] takes Siconos'
+/// θ-method and Newton loop (`MoreauJeanOSI(0.5, 0.5)` in a `TimeStepping`
+/// with its default Newton loop) but **not** Siconos' Newton's law: its
+/// approach velocity is [`ApproachVelocity::Slower`], which never creates
+/// energy at an impact. [`StepParams::siconos`] is Siconos' settings in
+/// full ([`ApproachVelocity::Start`]), for step-by-step agreement with it.
+///
+/// ```
+/// use moreau_runtime::{ApproachVelocity, StepParams};
+///
+/// let ours = StepParams::new(1e-3);
+/// assert_eq!(ours.approach_velocity, ApproachVelocity::Slower);
+/// let siconos = StepParams::siconos(1e-3);
+/// assert_eq!(siconos, ours.with_approach_velocity(ApproachVelocity::Start));
+/// // every setting has its builder
+/// let stiff = StepParams::new(1e-4)
+///     .with_theta(1.0)
+///     .with_gamma(0.0)
+///     .with_newton_tolerance(1e-10)
+///     .with_newton_iterations(1);
+/// assert_eq!((stiff.theta, stiff.gamma, stiff.newton_iterations), (1.0, 0.0, 1));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepParams<T> {
     /// Time step `τ > 0` (no default; [`StepParams::new`] takes it).
@@ -94,8 +112,10 @@ pub enum ApproachVelocity {
 }
 
 impl<T: RealField + Copy> StepParams<T> {
-    /// Siconos' settings (`θ = γ = 0.5`, Newton `1e-6`, 50 iterations) with
-    /// time step `tau`, and the default [`ApproachVelocity::Slower`].
+    /// Time step `tau` with the defaults: Siconos' θ-method and Newton loop
+    /// (`θ = γ = 0.5`, Newton tolerance `1e-6`, 50 iterations) and *our*
+    /// Newton's law, [`ApproachVelocity::Slower`] (Siconos' is
+    /// [`ApproachVelocity::Start`]: see [`StepParams::siconos`]).
     #[must_use]
     pub fn new(tau: T) -> Self {
         Self {
@@ -105,6 +125,61 @@ impl<T: RealField + Copy> StepParams<T> {
             newton_tolerance: nalgebra::convert(1e-6),
             newton_iterations: 50,
             approach_velocity: ApproachVelocity::Slower,
+        }
+    }
+
+    /// Siconos' settings in full, its Newton's law included: [`new`](Self::new)
+    /// with [`ApproachVelocity::Start`]. With these the stepper agrees with
+    /// Siconos' `MoreauJeanOSI` step by step (`tests/plant.rs`).
+    #[must_use]
+    pub fn siconos(tau: T) -> Self {
+        Self::new(tau).with_approach_velocity(ApproachVelocity::Start)
+    }
+
+    /// The same settings with time step `τ`.
+    #[must_use]
+    pub fn with_tau(self, tau: T) -> Self {
+        Self { tau, ..self }
+    }
+
+    /// The same settings with `θ` (see [`theta`](Self::theta)).
+    #[must_use]
+    pub fn with_theta(self, theta: T) -> Self {
+        Self { theta, ..self }
+    }
+
+    /// The same settings with `γ` (see [`gamma`](Self::gamma)).
+    #[must_use]
+    pub fn with_gamma(self, gamma: T) -> Self {
+        Self { gamma, ..self }
+    }
+
+    /// The same settings with this Newton tolerance (see
+    /// [`newton_tolerance`](Self::newton_tolerance)).
+    #[must_use]
+    pub fn with_newton_tolerance(self, newton_tolerance: T) -> Self {
+        Self {
+            newton_tolerance,
+            ..self
+        }
+    }
+
+    /// The same settings with at most this many Newton iterations (see
+    /// [`newton_iterations`](Self::newton_iterations)).
+    #[must_use]
+    pub fn with_newton_iterations(self, newton_iterations: u32) -> Self {
+        Self {
+            newton_iterations,
+            ..self
+        }
+    }
+
+    /// The same settings with this Newton's law (see [`ApproachVelocity`]).
+    #[must_use]
+    pub fn with_approach_velocity(self, approach_velocity: ApproachVelocity) -> Self {
+        Self {
+            approach_velocity,
+            ..self
         }
     }
 }

@@ -24,7 +24,7 @@ pub struct StepReport<T: RealField + Copy, const K: usize> {
     /// End time of the step, `t_{k+1}`.
     pub t: T,
     /// The index set of the step (γ-prediction at the start).
-    pub active: IndexSet,
+    pub active: IndexSet<K>,
     /// The LCP multipliers `λ` of the last Newton iteration (zero off the
     /// index set).
     pub impulses: SVector<T, K>,
@@ -45,7 +45,7 @@ pub struct StepReport<T: RealField + Copy, const K: usize> {
 impl<T: RealField + Copy, const K: usize> StepReport<T, K> {
     /// A report for the step ending at `t` with index set `active`, before
     /// any iteration.
-    pub(super) fn new(t: T, active: IndexSet) -> Self {
+    pub(super) fn new(t: T, active: IndexSet<K>) -> Self {
         Self {
             t,
             active,
@@ -67,7 +67,7 @@ impl<T: RealField + Copy, const K: usize> StepReport<T, K> {
     }
 
     /// The constraints that received an impulse (`λ > 0`) in this step.
-    pub fn impacting(&self) -> IndexSet {
+    pub fn impacting(&self) -> IndexSet<K> {
         let mut set = IndexSet::new();
         for i in self.active {
             if self.impulses[i] > T::zero() {
