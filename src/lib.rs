@@ -83,7 +83,9 @@ pub use moreau_runtime::*;
 /// public API: it may change in any release.
 #[doc(hidden)]
 pub mod __private {
-    pub use moreau_runtime::{Linearization, Model, ModelInfo, Sensitivities, Terms};
+    pub use moreau_runtime::{
+        Enclose, Enclosure, Linearization, Model, ModelInfo, Sensitivities, Structure, Terms,
+    };
     pub use nalgebra::{ArrayStorage, RealField, SMatrix, SVector};
 
     /// Converts a literal of the model to the scalar type; exact for `f64`,
@@ -91,5 +93,12 @@ pub mod __private {
     #[inline(always)]
     pub fn cst<T: RealField + Copy>(x: f64) -> T {
         nalgebra::convert(x)
+    }
+
+    /// A parameter's value as an `f64` point of an enclosure (`NaN`, which
+    /// encloses nothing, if the scalar has no `f64` value).
+    #[inline(always)]
+    pub fn point<T: RealField + Copy, I: Enclose>(x: T) -> I {
+        I::point(x.to_subset().unwrap_or(f64::NAN))
     }
 }

@@ -316,3 +316,140 @@ fn f32_agrees_with_f64() {
         assert!(relative_error(&t32.jacobian.cast(), &t64.jacobian) < 1e-5);
     }
 }
+
+/// A degenerate enclosure: one `f64` point, each operation `f64`'s own.
+/// Evaluated through `Enclosure`, it must give the `f64` methods' values
+/// bit for bit (same instruction list, same operations).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Pt(f64);
+
+impl std::ops::Add for Pt {
+    type Output = Pt;
+    fn add(self, o: Pt) -> Pt {
+        Pt(self.0 + o.0)
+    }
+}
+impl std::ops::Sub for Pt {
+    type Output = Pt;
+    fn sub(self, o: Pt) -> Pt {
+        Pt(self.0 - o.0)
+    }
+}
+impl std::ops::Mul for Pt {
+    type Output = Pt;
+    fn mul(self, o: Pt) -> Pt {
+        Pt(self.0 * o.0)
+    }
+}
+impl std::ops::Div for Pt {
+    type Output = Pt;
+    fn div(self, o: Pt) -> Pt {
+        Pt(self.0 / o.0)
+    }
+}
+impl std::ops::Neg for Pt {
+    type Output = Pt;
+    fn neg(self) -> Pt {
+        Pt(-self.0)
+    }
+}
+impl moreau::Enclose for Pt {
+    fn point(x: f64) -> Self {
+        Pt(x)
+    }
+    fn entire() -> Self {
+        Pt(f64::NAN)
+    }
+    fn powi(self, n: i32) -> Self {
+        Pt(self.0.powi(n))
+    }
+    fn powf(self, e: Self) -> Self {
+        Pt(self.0.powf(e.0))
+    }
+    fn sqrt(self) -> Self {
+        Pt(self.0.sqrt())
+    }
+    fn exp(self) -> Self {
+        Pt(self.0.exp())
+    }
+    fn ln(self) -> Self {
+        Pt(self.0.ln())
+    }
+    fn sin(self) -> Self {
+        Pt(self.0.sin())
+    }
+    fn cos(self) -> Self {
+        Pt(self.0.cos())
+    }
+    fn tan(self) -> Self {
+        Pt(self.0.tan())
+    }
+    fn sinh(self) -> Self {
+        Pt(self.0.sinh())
+    }
+    fn cosh(self) -> Self {
+        Pt(self.0.cosh())
+    }
+    fn tanh(self) -> Self {
+        Pt(self.0.tanh())
+    }
+    fn atan2(self, x: Self) -> Self {
+        Pt(self.0.atan2(x.0))
+    }
+}
+
+fn enclosure_at_points<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
+where
+    M: moreau::Enclosure<N, K> + Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
+{
+    for (i, p) in points::<M, N, K, NU>(stem).iter().enumerate() {
+        let (m, t, q, v, u) = (&p.model, p.t, &p.q, &p.v, &p.u);
+        let qp: [Pt; N] = std::array::from_fn(|k| Pt(q[k]));
+        let vp: [Pt; N] = std::array::from_fn(|k| Pt(v[k]));
+        let up: Vec<Pt> = u.iter().map(|&x| Pt(x)).collect();
+        let (mass, coriolis) = (m.mass(q), m.coriolis(q, v));
+        let dfdv = m.linearization(t, q, v, u).forces_dv;
+        let (em, ec) = (m.mass_enclosure(&qp), m.coriolis_enclosure(&qp, &vp));
+        let ef = m.forces_dv_enclosure(Pt(t), &qp, &vp, &up);
+        for r in 0..N {
+            for c in 0..N {
+                assert_eq!(em[r][c].0.to_bits(), mass[(r, c)].to_bits(), "{stem} {i} M");
+                assert_eq!(
+                    ec[r][c].0.to_bits(),
+                    coriolis[(r, c)].to_bits(),
+                    "{stem} {i} C"
+                );
+                assert_eq!(
+                    ef[r][c].0.to_bits(),
+                    dfdv[(r, c)].to_bits(),
+                    "{stem} {i} ∂F/∂v"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn enclosures_at_points_are_the_f64_values() {
+    enclosure_at_points::<Parabola, 2, 2, 0>("parabola");
+    enclosure_at_points::<ThreeBalls, 3, 4, 0>("three_balls");
+    enclosure_at_points::<Billiard, 2, 4, 0>("billiard");
+    enclosure_at_points::<DoublePendulum, 2, 2, 0>("double_pendulum");
+    enclosure_at_points::<Arm3, 3, 1, 3>("arm3");
+}
+
+/// What the compiler proves of the shipped models' structure, against what
+/// their model text shows: Example 1 is a point mass under gravity (M = m I,
+/// F = G constant); the double pendulum's M depends on th1 − th2 and it has
+/// joint damping.
+#[test]
+fn structure_flags_match_the_models() {
+    let p = Parabola::<f64>::STRUCTURE;
+    assert!(p.mass_constant && p.mass_diagonal && p.forces_velocity_free);
+    assert!(p.forces_configuration_free && p.forces_time_free && p.forces_input_free);
+    assert!(!p.jacobian_constant); // the floor y − x² curves
+    let d = DoublePendulum::<f64>::STRUCTURE;
+    assert!(!d.mass_constant && !d.mass_diagonal && !d.forces_velocity_free);
+    let b = ThreeBalls::<f64>::STRUCTURE;
+    assert!(b.mass_constant && b.mass_diagonal && b.jacobian_constant);
+}

@@ -9,6 +9,7 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
+mod enclosure;
 mod error;
 mod lcp;
 mod linalg;
@@ -20,9 +21,10 @@ mod stepper;
 mod testing;
 mod validate;
 
+pub use enclosure::{Enclose, Enclosure};
 pub use error::DataError;
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
-pub use model::{Linearization, Model, ModelInfo, Sensitivities, Terms};
+pub use model::{Linearization, Model, ModelInfo, Sensitivities, Structure, Terms};
 pub use observer::{
     Design, Discretization, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
     ObserverError, ObserverParams, ReducedOrder, Restart, UpdateReport,

@@ -19,6 +19,47 @@
 
 use nalgebra::{RealField, SMatrix, SVector};
 
+/// Structural facts about a model, decided by the compiler from the
+/// model's symbolic form (each `true` is a proof, each `false` says only
+/// that it could not be shown).
+///
+/// ```
+/// use moreau_runtime::Structure;
+/// let s = Structure::GENERAL;
+/// assert!(!s.mass_constant && !s.forces_velocity_free);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Structure {
+    /// `M` does not depend on `q` (nor on parameters changing at run time:
+    /// it may depend on parameters, which are constant during a run).
+    pub mass_constant: bool,
+    /// `M` is diagonal.
+    pub mass_diagonal: bool,
+    /// `F` does not depend on `v` (`∂F/∂v = 0`).
+    pub forces_velocity_free: bool,
+    /// `F` does not depend on `q` (`∂F/∂q = 0`).
+    pub forces_configuration_free: bool,
+    /// `F` does not depend on the time `t`.
+    pub forces_time_free: bool,
+    /// `F` does not depend on the inputs `u` (or there are none).
+    pub forces_input_free: bool,
+    /// `J` does not depend on `q` (every gap is affine in `q`).
+    pub jacobian_constant: bool,
+}
+
+impl Structure {
+    /// Nothing known: every flag `false`.
+    pub const GENERAL: Structure = Structure {
+        mass_constant: false,
+        mass_diagonal: false,
+        forces_velocity_free: false,
+        forces_configuration_free: false,
+        forces_time_free: false,
+        forces_input_free: false,
+        jacobian_constant: false,
+    };
+}
+
 /// Static facts about a model: names, the model text and the size of its
 /// generated code.
 ///
@@ -143,6 +184,11 @@ pub trait Model<const N: usize, const K: usize> {
 
     /// Names, model text and operation count.
     const INFO: ModelInfo<N, K>;
+
+    /// What the compiler knows of the model's structure (`M` constant or
+    /// diagonal, forces free of `v`, ...), so that the runtime can take the
+    /// short path where it holds. The default claims nothing.
+    const STRUCTURE: Structure = Structure::GENERAL;
 
     /// Mass matrix `M(q) = ∂²T/∂v²`, symmetric positive definite.
     fn mass(&self, q: &SVector<Self::Scalar, N>) -> SMatrix<Self::Scalar, N, N>;

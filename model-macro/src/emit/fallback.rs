@@ -52,6 +52,12 @@ pub(crate) fn fallback(spec: &ModelSpec) -> TokenStream {
             fn parameter_mut(&mut self, index: usize) -> ::core::option::Option<&mut T> { ::core::unimplemented!() }
         }
         #[allow(unused_variables)]
+        impl<T: ::moreau::__private::RealField + ::core::marker::Copy> ::moreau::__private::Enclosure<#n, #k> for #name<T> {
+            fn mass_enclosure<I: ::moreau::__private::Enclose>(&self, q: &[I; #n]) -> [[I; #n]; #n] { ::core::unimplemented!() }
+            fn coriolis_enclosure<I: ::moreau::__private::Enclose>(&self, q: &[I; #n], v: &[I; #n]) -> [[I; #n]; #n] { ::core::unimplemented!() }
+            fn forces_dv_enclosure<I: ::moreau::__private::Enclose>(&self, t: I, q: &[I; #n], v: &[I; #n], u: &[I]) -> [[I; #n]; #n] { ::core::unimplemented!() }
+        }
+        #[allow(unused_variables)]
         impl<T: ::moreau::__private::RealField + ::core::marker::Copy> ::moreau::__private::Sensitivities<#n, #k> for #name<T> {
             fn mass_dq(&self, q: &::moreau::__private::SVector<T, #n>, w: &::moreau::__private::SVector<T, #n>) -> ::moreau::__private::SMatrix<T, #n, #n> { ::core::unimplemented!() }
             fn jacobian_dq(&self, q: &::moreau::__private::SVector<T, #n>, v: &::moreau::__private::SVector<T, #n>) -> ::moreau::__private::SMatrix<T, #k, #n> { ::core::unimplemented!() }

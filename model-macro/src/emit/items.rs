@@ -9,7 +9,7 @@ use moreau_sym::Quantity::{
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::quote;
 
-use super::print::float;
+use super::print::{Scalar, float};
 use super::{Emitter, int, matrix};
 use crate::expr::fmt_number;
 use crate::render;
@@ -49,7 +49,8 @@ impl Emitter<'_, '_> {
         let inherent = self.inherent_items();
         let model = self.model_impl();
         let sensitivities = self.sensitivities_impl();
-        quote! { #strukt #tracking #inherent #model #sensitivities }
+        let enclosure = self.enclosure_impl();
+        quote! { #strukt #tracking #inherent #model #sensitivities #enclosure }
     }
 
     fn name(&self) -> Ident {
@@ -219,6 +220,7 @@ impl Emitter<'_, '_> {
             quote!(::moreau::__private::Terms { mass: #mm, coriolis: #c, gravity: #g, forces: #f, gaps: #h, jacobian: #j })
         });
         let info = self.info();
+        let structure = self.structure();
         let parameters = self.parameter_arms();
         let (n, k) = (int(n), int(k));
         quote! {
@@ -228,6 +230,7 @@ impl Emitter<'_, '_> {
                 type Input = #input;
 
                 const INFO: ::moreau::__private::ModelInfo<#n, #k> = #info;
+                const STRUCTURE: ::moreau::__private::Structure = #structure;
 
                 #[inline]
                 fn mass(&self, #q: &#vec_n) -> #mat_nn { #mass }
@@ -298,6 +301,52 @@ impl Emitter<'_, '_> {
                 fn jacobian_dq(&self, #q: &#vec_n, #v: &#vec_n) -> #mat_kn { #jacobian_dq }
             }
         }
+    }
+
+    /// `impl Enclosure`: `M`, `C` and `∂F/∂v` over boxes, from the same
+    /// instruction list, over any `I: Enclose`.
+    fn enclosure_impl(&self) -> TokenStream {
+        let (name, bound) = (self.name(), bound());
+        let (n, k) = (self.model.n(), self.model.k());
+        let (q, v, t, u) = args();
+        let over = |qs: &[Quantity]| self.method_body_over(Scalar::Enclosure, qs, |m| m[0].clone());
+        let (mass, coriolis, forces_dv) = (over(&[Mass]), over(&[Coriolis]), over(&[ForceDv]));
+        let (n, k) = (int(n), int(k));
+        quote! {
+            #[allow(non_snake_case, unused_variables, clippy::all)]
+            impl<#bound> ::moreau::__private::Enclosure<#n, #k> for #name<T> {
+                #[inline]
+                fn mass_enclosure<I: ::moreau::__private::Enclose>(&self, #q: &[I; #n]) -> [[I; #n]; #n] { #mass }
+                #[inline]
+                fn coriolis_enclosure<I: ::moreau::__private::Enclose>(&self, #q: &[I; #n], #v: &[I; #n]) -> [[I; #n]; #n] { #coriolis }
+                #[inline]
+                fn forces_dv_enclosure<I: ::moreau::__private::Enclose>(&self, #t: I, #q: &[I; #n], #v: &[I; #n], #u: &[I]) -> [[I; #n]; #n] { #forces_dv }
+            }
+        }
+    }
+
+    /// `Structure`: what the symbolic form shows of `M`, `F` and `J`.
+    fn structure(&self) -> TokenStream {
+        let s = self.facts;
+        let flags = [
+            s.mass_constant,
+            s.mass_diagonal,
+            s.forces_velocity_free,
+            s.forces_configuration_free,
+            s.forces_time_free,
+            s.forces_input_free,
+            s.jacobian_constant,
+        ];
+        let [a, b, c, d, e, f, g] = flags;
+        quote!(::moreau::__private::Structure {
+            mass_constant: #a,
+            mass_diagonal: #b,
+            forces_velocity_free: #c,
+            forces_configuration_free: #d,
+            forces_time_free: #e,
+            forces_input_free: #f,
+            jacobian_constant: #g,
+        })
     }
 
     /// The type's documentation, ending with the listing of `eval`.

@@ -29,14 +29,14 @@ mod print;
 
 pub(crate) use fallback::fallback;
 
-use moreau_sym::{Layout, Quantity, Schedule, Slot};
+use moreau_sym::{Id, Layout, Quantity, Schedule, Slot, VarId};
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use crate::lower::Lowered;
-use crate::resolve::Resolved;
+use crate::resolve::{Resolved, Var};
 use body::Body;
-use print::{Text, Tokens};
+use print::{Scalar, Text, Tokens};
 
 /// The generated items for a resolved, lowered model.
 pub(crate) fn emit(model: &Resolved<'_>, lowered: &Lowered) -> TokenStream {
@@ -54,6 +54,47 @@ pub(crate) struct Emitter<'a, 'm> {
     model: &'a Resolved<'m>,
     outputs: Layout,
     full: Schedule,
+    facts: Facts,
+}
+
+/// Structural facts read off the symbolic form (the generated
+/// `Model::STRUCTURE`).
+#[derive(Clone, Copy, Debug)]
+struct Facts {
+    mass_constant: bool,
+    mass_diagonal: bool,
+    forces_velocity_free: bool,
+    forces_configuration_free: bool,
+    forces_time_free: bool,
+    forces_input_free: bool,
+    jacobian_constant: bool,
+}
+
+impl Facts {
+    fn of(model: &Resolved<'_>, lowered: &Lowered) -> Facts {
+        let (g, mech, l) = (&lowered.graph, &lowered.mechanics, model.layout);
+        let coordinates: Vec<_> = (0..l.n).map(|i| l.id(Var::Coordinate(i))).collect();
+        let inputs: Vec<_> = (0..l.inputs).map(|i| l.id(Var::Input(i))).collect();
+        let free_of = |ids: Vec<Id>, vars: &[VarId]| {
+            ids.iter()
+                .all(|&id| vars.iter().all(|&x| !g.depends_on(id, x)))
+        };
+        let zero = |ids: Vec<Id>| ids.iter().all(|&id| g.is_zero(id));
+        let flat = |m: &[Vec<Id>]| m.iter().flatten().copied().collect::<Vec<Id>>();
+        let off_diagonal: Vec<Id> = (0..l.n)
+            .flat_map(|i| (0..l.n).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| mech.mass[i][j])
+            .collect();
+        Facts {
+            mass_constant: free_of(flat(&mech.mass), &coordinates),
+            mass_diagonal: zero(off_diagonal),
+            forces_velocity_free: zero(flat(&mech.force_dv)),
+            forces_configuration_free: zero(flat(&mech.force_dq)),
+            forces_time_free: free_of(mech.forces.clone(), &[l.id(Var::Time)]),
+            forces_input_free: free_of(mech.forces.clone(), &inputs),
+            jacobian_constant: free_of(flat(&mech.jacobian), &coordinates),
+        }
+    }
 }
 
 impl<'a, 'm> Emitter<'a, 'm> {
@@ -63,6 +104,7 @@ impl<'a, 'm> Emitter<'a, 'm> {
             model,
             outputs: mech.layout(),
             full: Schedule::new(&lowered.graph, &mech.outputs()),
+            facts: Facts::of(model, lowered),
         }
     }
 
@@ -87,20 +129,37 @@ impl<'a, 'm> Emitter<'a, 'm> {
         qs: &[Quantity],
         ret: impl FnOnce(&[TokenStream]) -> TokenStream,
     ) -> TokenStream {
+        self.method_body_over(Scalar::Model, qs, ret)
+    }
+
+    /// [`method_body`](Self::method_body) over the model's scalar (each
+    /// quantity an `SMatrix`) or an enclosure type (each an array of rows).
+    fn method_body_over(
+        &self,
+        scalar: Scalar,
+        qs: &[Quantity],
+        ret: impl FnOnce(&[TokenStream]) -> TokenStream,
+    ) -> TokenStream {
         let (indices, body) = self.body(qs);
         let model = self.model;
-        let statements = Tokens::of(|t| print::statements(t, model, &body));
+        let statements = Tokens::of(scalar, |t| print::statements(t, model, &body));
         let entry = |slot: Slot| {
             let index = self.outputs.index(slot);
             let pos = indices.iter().position(|&i| i == index).unwrap_or(0);
-            Tokens::of(|t| print::code(t, &body.names, model, &body.outputs[pos]))
+            Tokens::of(scalar, |t| {
+                print::code(t, &body.names, model, &body.outputs[pos])
+            })
         };
         let (n, k) = (model.n(), model.k());
         let matrices: Vec<TokenStream> = qs
             .iter()
             .map(|&quantity| {
                 let (rows, cols) = quantity.shape(n, k);
-                matrix(rows, cols, |row, col| entry(Slot { quantity, row, col }))
+                let at = |row, col| entry(Slot { quantity, row, col });
+                match scalar {
+                    Scalar::Model => matrix(rows, cols, at),
+                    Scalar::Enclosure => rows_array(rows, cols, at),
+                }
             })
             .collect();
         let value = ret(&matrices);
@@ -138,6 +197,15 @@ fn matrix(rows: usize, cols: usize, at: impl Fn(usize, usize) -> TokenStream) ->
     quote!(::moreau::__private::SMatrix::from_array_storage(
         ::moreau::__private::ArrayStorage([#(#columns),*])
     ))
+}
+
+/// `[[a00, a01], [a10, a11]]`: rows of entries `at(i, j)`.
+fn rows_array(rows: usize, cols: usize, at: impl Fn(usize, usize) -> TokenStream) -> TokenStream {
+    let rows = (0..rows).map(|i| {
+        let entries = (0..cols).map(|j| at(i, j));
+        quote!([#(#entries),*])
+    });
+    quote!([#(#rows),*])
 }
 
 /// An integer literal without a suffix (`2`, not `2usize`).

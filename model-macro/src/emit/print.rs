@@ -27,6 +27,8 @@ pub(crate) trait Sink {
     fn field(&mut self, name: &str);
     /// `[i]`.
     fn index(&mut self, i: usize);
+    /// Input `i` (`u[i]`).
+    fn input(&mut self, i: usize);
     /// The scalar constant `x` (`cst(x)`).
     fn cst(&mut self, x: f64);
     /// An integer literal.
@@ -119,7 +121,7 @@ pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) 
                 Var::Coordinate(i) => index(s, "q", i),
                 Var::Velocity(i) => index(s, "v", i),
                 Var::Time => s.internal("t"),
-                Var::Input(i) => index(s, "u", i),
+                Var::Input(i) => s.input(i),
                 Var::Parameter(_) => s.field(model.var_name(var)),
             },
             None,
@@ -203,7 +205,8 @@ fn parts(body: &Body) -> Vec<Part> {
         }
     };
     for (i, l) in body.lets.iter().enumerate() {
-        l.code.visit_locals(&mut |local| read(Some(i / PART), local));
+        l.code
+            .visit_locals(&mut |local| read(Some(i / PART), local));
     }
     for out in &body.outputs {
         out.visit_locals(&mut |local| read(None, local));
@@ -222,9 +225,18 @@ fn index<S: Sink>(s: &mut S, arg: &str, i: usize) {
     s.index(i);
 }
 
+/// The scalar of generated code: the model's `T`, or an enclosure type
+/// `I: Enclose` (interval evaluation, `Enclosure`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum Scalar {
+    #[default]
+    Model,
+    Enclosure,
+}
+
 /// The token sink.
 #[derive(Default)]
-pub(crate) struct Tokens(pub TokenStream);
+pub(crate) struct Tokens(pub TokenStream, pub Scalar);
 
 impl Tokens {
     fn push(&mut self, t: impl Into<TokenTree>) {
@@ -232,16 +244,32 @@ impl Tokens {
     }
 
     fn group(&mut self, d: Delimiter, inner: &mut dyn FnMut(&mut Self)) {
-        let mut sub = Tokens::default();
+        let mut sub = Tokens(TokenStream::new(), self.1);
         inner(&mut sub);
         self.push(Group::new(d, sub.0));
     }
 
-    /// Prints with a fresh token sink and returns the tokens.
-    pub fn of(f: impl FnOnce(&mut Tokens)) -> TokenStream {
-        let mut t = Tokens::default();
+    /// Prints with a fresh token sink over `scalar` and returns the tokens.
+    pub fn of(scalar: Scalar, f: impl FnOnce(&mut Tokens)) -> TokenStream {
+        let mut t = Tokens(TokenStream::new(), scalar);
         f(&mut t);
         t.0
+    }
+
+    /// The scalar type's name (`T` or `I`).
+    fn scalar_type(&self) -> Ident {
+        match self.1 {
+            Scalar::Model => Ident::new("T", Span::call_site()),
+            Scalar::Enclosure => Ident::new("I", Span::call_site()),
+        }
+    }
+
+    /// The bound of the scalar type.
+    fn scalar_bound(&self) -> TokenStream {
+        match self.1 {
+            Scalar::Model => quote!(::moreau::__private::RealField + ::core::marker::Copy),
+            Scalar::Enclosure => quote!(::moreau::__private::Enclose),
+        }
     }
 }
 
@@ -254,7 +282,22 @@ impl Sink for Tokens {
     }
     fn field(&mut self, name: &str) {
         let field = Ident::new(name, Span::call_site());
-        self.0.extend(quote!(self.#field));
+        match self.1 {
+            Scalar::Model => self.0.extend(quote!(self.#field)),
+            Scalar::Enclosure => self
+                .0
+                .extend(quote!(::moreau::__private::point::<T, I>(self.#field))),
+        }
+    }
+    fn input(&mut self, i: usize) {
+        let u = Ident::new("u", Span::mixed_site());
+        let i = Literal::usize_unsuffixed(i);
+        match self.1 {
+            Scalar::Model => self.0.extend(quote!(#u[#i])),
+            Scalar::Enclosure => self
+                .0
+                .extend(quote!(#u.get(#i).copied().unwrap_or_else(I::entire))),
+        }
     }
     fn index(&mut self, i: usize) {
         let i = Literal::usize_unsuffixed(i);
@@ -262,7 +305,10 @@ impl Sink for Tokens {
     }
     fn cst(&mut self, x: f64) {
         let x = float(x);
-        self.0.extend(quote!(::moreau::__private::cst(#x)));
+        match self.1 {
+            Scalar::Model => self.0.extend(quote!(::moreau::__private::cst(#x))),
+            Scalar::Enclosure => self.0.extend(quote!(I::point(#x))),
+        }
     }
     fn int(&mut self, n: i32) {
         self.push(Literal::i32_unsuffixed(n));
@@ -285,7 +331,14 @@ impl Sink for Tokens {
         body: &mut dyn FnMut(&mut Self),
     ) {
         let ident = |&(name, user): &(&str, bool)| {
-            Ident::new(name, if user { Span::call_site() } else { Span::mixed_site() })
+            Ident::new(
+                name,
+                if user {
+                    Span::call_site()
+                } else {
+                    Span::mixed_site()
+                },
+            )
         };
         let ins: Vec<Ident> = live_in.iter().map(ident).collect();
         let outs: Vec<Ident> = live_out.iter().map(ident).collect();
@@ -293,15 +346,16 @@ impl Sink for Tokens {
             Literal::usize_unsuffixed(ins.len()),
             Literal::usize_unsuffixed(outs.len()),
         );
-        let inner = Tokens::of(|t| body(t));
+        let inner = Tokens::of(self.1, |t| body(t));
         let (part, input) = (
             Ident::new("part", Span::mixed_site()),
             Ident::new("input", Span::mixed_site()),
         );
+        let (ty, bound) = (self.scalar_type(), self.scalar_bound());
         self.0.extend(quote! {
             let [#(#outs),*] = {
                 #[inline(never)]
-                fn #part<T: ::moreau::__private::RealField + ::core::marker::Copy>(#input: [T; #nin]) -> [T; #nout] {
+                fn #part<#ty: #bound>(#input: [#ty; #nin]) -> [#ty; #nout] {
                     let [#(#ins),*] = #input;
                     #inner
                     [#(#outs),*]
@@ -320,7 +374,8 @@ impl Sink for Tokens {
         self.0.extend(quote!(let));
         name(self);
         if typed {
-            self.0.extend(quote!(: T));
+            let ty = self.scalar_type();
+            self.0.extend(quote!(: #ty));
         }
         self.push(Punct::new('=', Spacing::Alone));
         value(self);
@@ -359,6 +414,9 @@ impl Sink for Text {
     }
     fn index(&mut self, i: usize) {
         self.0.push_str(&format!("[{i}]"));
+    }
+    fn input(&mut self, i: usize) {
+        self.0.push_str(&format!("u[{i}]"));
     }
     fn cst(&mut self, x: f64) {
         self.0.push_str(&format!("cst({})", fmt_number(x)));

@@ -283,11 +283,7 @@ fn chain(first: Expr, rest: Vec<(bool, Loc, Expr)>, direct: BinOp, inverse: BinO
 }
 
 /// Combines signed operands (at least one) pairwise, halves first.
-fn balanced(
-    mut items: Vec<(bool, Loc, Expr)>,
-    direct: BinOp,
-    inverse: BinOp,
-) -> (bool, Loc, Expr) {
+fn balanced(mut items: Vec<(bool, Loc, Expr)>, direct: BinOp, inverse: BinOp) -> (bool, Loc, Expr) {
     if items.len() == 1 {
         return items.remove(0);
     }
