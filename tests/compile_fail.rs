@@ -10,7 +10,8 @@ use std::path::PathBuf;
 fn malformed_models_are_spanned_compile_errors() {
     // trybuild compiles each case inside its own crate, under
     // `target/tests/trybuild/moreau`; a model file must lie inside the
-    // calling crate, so the YAML cases' files are copied there first.
+    // calling crate, so the YAML cases' files (and the URDFs they name) are
+    // copied there first.
     let target = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .parent()
         .expect("the target directory")
@@ -20,7 +21,7 @@ fn malformed_models_are_spanned_compile_errors() {
     let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/ui/yaml");
     for entry in std::fs::read_dir(&source).expect("tests/ui/yaml") {
         let path = entry.expect("a directory entry").path();
-        if path.extension().is_some_and(|e| e == "yaml") {
+        if path.extension().is_some_and(|e| e == "yaml" || e == "urdf") {
             std::fs::copy(
                 &path,
                 project_yaml.join(path.file_name().expect("a file name")),

@@ -10,7 +10,7 @@
 use std::collections::HashSet;
 
 use crate::ctxt::Ctxt;
-use crate::expr::Expr;
+use crate::expr::{Expr, ExprKind, POSITION_FUNCTIONS};
 use crate::keys;
 use crate::loc::Loc;
 use crate::resolve::{Scope, Symbol, Var};
@@ -27,6 +27,9 @@ pub(crate) fn check(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     check_restitution(cx, spec);
     check_initial(cx, spec, scope);
     check_numbers_finite(cx, spec);
+    check_tree(cx, spec, scope);
+    check_body_fields(cx, spec, scope);
+    check_body_references(cx, spec, scope);
 }
 
 // Every declared name becomes a Rust identifier (a field, a binding or the
@@ -91,6 +94,15 @@ fn check_name_forms(cx: &Ctxt, spec: &ModelSpec) {
     }
     for c in &spec.constraints {
         check(&c.name, "a constraint");
+    }
+    for b in &spec.bodies {
+        check(&b.name, "a body");
+        if b.name.text == keys::WORLD {
+            cx.error(
+                b.name.loc,
+                "`world` cannot name a body: it is the fixed base, the parent of the tree's roots",
+            );
+        }
     }
     for (name, _) in spec.declared() {
         if RESERVED.contains(&name.text.as_str()) {
@@ -384,5 +396,119 @@ fn check_numbers_finite(cx: &Ctxt, spec: &ModelSpec) {
         if !n.value.is_finite() {
             cx.error(n.loc, "expected a finite number");
         }
+    }
+}
+
+// A body's parent is `world` or another body, and following parents from
+// any body reaches `world` (the tree has no cycle).
+fn check_tree(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    let parent_of = |i: usize| -> Option<usize> {
+        let p = spec.bodies[i].parent.as_ref()?;
+        match scope.get(&p.text) {
+            Some(Symbol::Body(j)) => Some(j),
+            _ => None,
+        }
+    };
+    for (i, b) in spec.bodies.iter().enumerate() {
+        if let Some(p) = &b.parent
+            && !matches!(scope.get(&p.text), Some(Symbol::Body(_)))
+        {
+            cx.error(
+                p.loc,
+                format!(
+                    "`{}` is not a body of this model; a body's parent is another body or `{}`",
+                    p.text,
+                    keys::WORLD
+                ),
+            );
+            continue;
+        }
+        // A walk longer than the number of bodies has met a cycle.
+        let mut at = i;
+        for _ in 0..=spec.bodies.len() {
+            match parent_of(at) {
+                Some(j) if j == i => {
+                    cx.error(
+                        b.name.loc,
+                        format!(
+                            "body `{}` is its own ancestor: the bodies form a cycle, not a tree",
+                            b.name.text
+                        ),
+                    );
+                    break;
+                }
+                Some(j) => at = j,
+                None => break,
+            }
+        }
+    }
+}
+
+// A body's numbers (placement, mass, centre of mass, inertia) and the
+// gravity vector are constants of the model: they may name parameters
+// (and `pi`), nothing else.
+fn check_body_fields(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    let check = |e: &Expr, what: &str| {
+        e.visit(&mut |name, loc| match scope.get(name) {
+            None => unknown(cx, name, loc),
+            Some(Symbol::Var(Var::Parameter(_)) | Symbol::Pi) => {}
+            Some(_) => cx.error(
+                loc,
+                format!("{what} may name only parameters, but it uses `{name}`"),
+            ),
+        });
+    };
+    for b in &spec.bodies {
+        let what = format!("a number of body `{}`", b.name.text);
+        let j = &b.joint;
+        let all = j
+            .xyz
+            .iter()
+            .chain(&j.rpy)
+            .chain([&b.mass])
+            .chain(&b.com)
+            .chain(&b.inertia);
+        for e in all {
+            check(e, &what);
+        }
+    }
+    for e in spec.gravity.iter().flatten() {
+        check(e, "`gravity`");
+    }
+}
+
+// A body is named only as the first argument of `position_x`, `_y` or
+// `_z`, and that argument names a body.
+fn check_body_references(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    fn walk(cx: &Ctxt, scope: &Scope<'_>, e: &Expr) {
+        match &e.kind {
+            ExprKind::Num(_) => {}
+            ExprKind::Name(name) => {
+                if let Some(Symbol::Body(_)) = scope.get(name) {
+                    cx.error(
+                        e.loc,
+                        format!("`{name}` is a body, not a number: use `position_x({name}, x, y, z)` (or `_y`, `_z`) for the world position of one of its points"),
+                    );
+                }
+            }
+            ExprKind::Neg(a) | ExprKind::Func(_, a) => walk(cx, scope, a),
+            ExprKind::Binary(_, a, b) | ExprKind::Atan2(a, b) => {
+                walk(cx, scope, a);
+                walk(cx, scope, b);
+            }
+            ExprKind::Position(axis, body, point) => {
+                match scope.get(body) {
+                    Some(Symbol::Body(_)) | None => {}
+                    Some(_) => cx.error(
+                        e.loc,
+                        format!("`{body}` is not a body: the first argument of `{}` names a body of `{}`", POSITION_FUNCTIONS[*axis], keys::BODIES),
+                    ),
+                }
+                point.iter().for_each(|c| walk(cx, scope, c));
+            }
+        }
+    }
+    for (_, e) in expressions(spec) {
+        walk(cx, scope, e);
     }
 }

@@ -19,17 +19,47 @@ pub(crate) const FORCES_RENAMED: &str = "forces";
 pub(crate) const CONSTRAINTS: &str = "constraints";
 pub(crate) const RESTITUTION: &str = "restitution";
 pub(crate) const INITIAL: &str = "initial";
+/// The kinematic tree: a list of bodies.
+pub(crate) const BODIES: &str = "bodies";
+/// A URDF file whose links and joints become `bodies`.
+pub(crate) const URDF: &str = "urdf";
+/// The URDF's joints to hold at zero (made fixed).
+pub(crate) const LOCKED: &str = "locked";
+/// The gravity vector of the tree (default `[0, 0, -9.81]`).
+pub(crate) const GRAVITY: &str = "gravity";
+/// Keys of one body (YAML).
+pub(crate) const PARENT: &str = "parent";
+pub(crate) const JOINT: &str = "joint";
+pub(crate) const MASS: &str = "mass";
+pub(crate) const COM: &str = "com";
+pub(crate) const INERTIA: &str = "inertia";
+pub(crate) const BODY_KEYS: [&str; 6] = [NAME, PARENT, JOINT, MASS, COM, INERTIA];
+/// Keys of a body's joint (YAML).
+pub(crate) const TYPE: &str = "type";
+pub(crate) const AXIS: &str = "axis";
+pub(crate) const XYZ: &str = "xyz";
+pub(crate) const RPY: &str = "rpy";
+pub(crate) const VELOCITY: &str = "velocity";
+pub(crate) const JOINT_KEYS: [&str; 6] = [TYPE, NAME, VELOCITY, AXIS, XYZ, RPY];
+/// The joint types of `bodies`.
+pub(crate) const JOINT_TYPES: [&str; 3] = ["revolute", "prismatic", "fixed"];
+/// The name of the fixed base as a parent.
+pub(crate) const WORLD: &str = "world";
 /// Keys of one constraint entry (YAML).
 pub(crate) const H: &str = "h";
 
 /// Every top-level YAML key, in the order the documentation lists them.
-pub(crate) const TOP_LEVEL: [&str; 12] = [
+pub(crate) const TOP_LEVEL: [&str; 16] = [
     NAME,
     DOC,
     COORDINATES,
     PARAMETERS,
     INPUTS,
     DEFINITIONS,
+    URDF,
+    LOCKED,
+    BODIES,
+    GRAVITY,
     KINETIC,
     POTENTIAL,
     APPLIED,

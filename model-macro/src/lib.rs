@@ -30,6 +30,7 @@ mod lower;
 mod render;
 mod resolve;
 mod spec;
+mod tree;
 
 use proc_macro::TokenStream;
 

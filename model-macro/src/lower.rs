@@ -13,6 +13,7 @@ use crate::ctxt::Ctxt;
 use crate::expr::{BinOp, Expr, ExprKind};
 use crate::loc::Loc;
 use crate::resolve::{Resolved, Symbol, Var, VarLayout};
+use crate::tree;
 
 /// The lowered model: its graph, variable layout and derived mechanics.
 pub(crate) struct Lowered {
@@ -30,15 +31,49 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
         layout,
         graph: Graph::new(),
         definitions: Vec::with_capacity(model.definitions.len()),
+        poses: vec![None; model.spec.bodies.len()],
     };
+    // The tree first: its fields name only parameters, and definitions and
+    // constraints may name its bodies' points.
+    let mut fields = Vec::with_capacity(model.bodies.len());
+    for body in &model.bodies {
+        fields.push(tree::BodyFields {
+            xyz: b.three(&body.xyz)?,
+            rpy: b.three(&body.rpy)?,
+            mass: b.expr(&body.mass)?,
+            com: b.three(&body.com)?,
+            inertia: [
+                b.expr(&body.inertia[0])?,
+                b.expr(&body.inertia[1])?,
+                b.expr(&body.inertia[2])?,
+                b.expr(&body.inertia[3])?,
+                b.expr(&body.inertia[4])?,
+                b.expr(&body.inertia[5])?,
+            ],
+        });
+    }
+    let gravity = b.three(&model.gravity)?;
+    let built = tree::build(&mut b.graph, layout, &model.bodies, &fields, gravity);
+    for (body, pose) in model.bodies.iter().zip(&built.poses) {
+        b.poses[body.index] = Some(*pose);
+    }
     for d in &model.definitions {
         let id = b.expr(d)?;
         b.definitions.push(id);
     }
-    let kinetic = b.expr(&model.kinetic)?;
+    let kinetic = match &model.kinetic {
+        Some(k) => {
+            let k = b.expr(k)?;
+            b.graph.add(k, built.kinetic)
+        }
+        None => built.kinetic,
+    };
     let potential = match &model.potential {
-        Some(p) => b.expr(p)?,
-        None => b.graph.constant(0.0),
+        Some(p) => {
+            let p = b.expr(p)?;
+            b.graph.add(p, built.potential)
+        }
+        None => built.potential,
     };
     let mut applied = Vec::with_capacity(layout.n);
     for a in &model.applied {
@@ -107,7 +142,7 @@ fn check_finite_constants(
             && !c.is_finite()
         {
             cx.error(
-                model.kinetic.loc,
+                model.energy_loc,
                 format!("a derived quantity of this model holds the constant {c}, which is not a finite number"),
             );
             return None;
@@ -139,8 +174,11 @@ fn check_mass_diagonal(
             } else {
                 format!("M[{i},{i}] = ∂²T/∂{v}² = {m} is negative")
             };
-            let loc =
-                first_use(model, &model.kinetic, Var::Velocity(i)).unwrap_or(model.kinetic.loc);
+            let loc = model
+                .kinetic
+                .as_ref()
+                .and_then(|k| first_use(model, k, Var::Velocity(i)))
+                .unwrap_or(model.energy_loc);
             cx.error(
                 loc,
                 format!("{why}: the mass matrix is not positive definite"),
@@ -163,8 +201,9 @@ fn report(cx: &Ctxt, model: &Resolved<'_>, e: &MechanicsError) {
         _ => None,
     };
     let loc = culprit
-        .and_then(|k| first_use(model, &model.kinetic, Var::Velocity(k)))
-        .unwrap_or(model.kinetic.loc);
+        .zip(model.kinetic.as_ref())
+        .and_then(|(k, kinetic)| first_use(model, kinetic, Var::Velocity(k)))
+        .unwrap_or(model.energy_loc);
     cx.error(loc, e.describe(&names));
 }
 
@@ -179,7 +218,7 @@ fn first_use(model: &Resolved<'_>, e: &Expr<Symbol>, var: Var) -> Option<Loc> {
         let hit = match *symbol {
             Symbol::Var(v) => v == var,
             Symbol::Definition(i) => first_use(model, &model.definitions[i], var).is_some(),
-            Symbol::Pi => false,
+            Symbol::Pi | Symbol::Body(_) => false,
         };
         if hit {
             found = Some(loc);
@@ -193,9 +232,15 @@ struct Builder<'a> {
     layout: VarLayout,
     graph: Graph,
     definitions: Vec<Id>,
+    /// The pose of each body, by its index in `ModelSpec::bodies`.
+    poses: Vec<Option<tree::Pose>>,
 }
 
 impl Builder<'_> {
+    fn three(&mut self, e: &[Expr<Symbol>; 3]) -> Option<[Id; 3]> {
+        Some([self.expr(&e[0])?, self.expr(&e[1])?, self.expr(&e[2])?])
+    }
+
     /// The node of `e`; `None` after reporting a subexpression that folds
     /// to a non-finite constant (`1/0`, `ln(0)`, `2^1024`).
     fn expr(&mut self, e: &Expr<Symbol>) -> Option<Id> {
@@ -206,6 +251,15 @@ impl Builder<'_> {
             ExprKind::Name(Symbol::Var(var)) => g.var(self.layout.id(*var)),
             ExprKind::Name(Symbol::Definition(i)) => self.definitions[*i],
             ExprKind::Name(Symbol::Pi) => g.constant(std::f64::consts::PI),
+            // The checks report a body named outside `position_x`.
+            ExprKind::Name(Symbol::Body(_)) => return None,
+            ExprKind::Position(axis, Symbol::Body(i), point) => {
+                let pose = self.poses[*i]?;
+                let local = self.three(point)?;
+                tree::point(&mut self.graph, &pose, local)[*axis]
+            }
+            // The checks report a `position_x` of something not a body.
+            ExprKind::Position(..) => return None,
             ExprKind::Neg(a) => {
                 let a = self.expr(a)?;
                 self.graph.neg(a)

@@ -13,7 +13,8 @@ use std::collections::HashMap;
 use moreau_sym::VarId;
 
 use crate::expr::Expr;
-use crate::spec::{ModelSpec, Name};
+use crate::loc::Loc;
+use crate::spec::{JointKind, ModelSpec, Name};
 
 /// A variable of the model: what the generated code reads from its
 /// arguments or its fields.
@@ -34,6 +35,9 @@ pub(crate) enum Symbol {
     Definition(usize),
     /// The constant π.
     Pi,
+    /// The `i`-th body of the kinematic tree, in the order written (only
+    /// as the first argument of `position_x`, `_y`, `_z`).
+    Body(usize),
 }
 
 /// The one name table of a model: declared names (first declaration wins;
@@ -63,6 +67,9 @@ impl<'a> Scope<'a> {
         }
         for (i, d) in spec.definitions.iter().enumerate() {
             add(&d.name, Symbol::Definition(i));
+        }
+        for (i, b) in spec.bodies.iter().enumerate() {
+            add(&b.name, Symbol::Body(i));
         }
         Scope { names }
     }
@@ -133,8 +140,16 @@ pub(crate) struct Resolved<'a> {
     pub layout: VarLayout,
     /// The definitions in order; each refers only to earlier ones.
     pub definitions: Vec<Expr<Symbol>>,
-    pub kinetic: Expr<Symbol>,
+    /// The kinetic energy as written; the tree's is added to it.
+    pub kinetic: Option<Expr<Symbol>>,
     pub potential: Option<Expr<Symbol>>,
+    /// Where the kinetic energy (or else the tree) was written: messages
+    /// about `M` point here.
+    pub energy_loc: Loc,
+    /// The kinematic tree, parents before children.
+    pub bodies: Vec<TreeBody>,
+    /// The gravity vector of the tree's potential energy.
+    pub gravity: [Expr<Symbol>; 3],
     /// The applied force on each coordinate, if any.
     pub applied: Vec<Option<Expr<Symbol>>>,
     /// The gap of each constraint.
@@ -170,6 +185,26 @@ impl Resolved<'_> {
     }
 }
 
+/// A body of the resolved tree.
+pub(crate) struct TreeBody {
+    /// The index of the body in `ModelSpec::bodies` (what `Symbol::Body`
+    /// names).
+    pub index: usize,
+    /// The parent's position in `Resolved::bodies` (always earlier), or
+    /// `None` for the world.
+    pub parent: Option<usize>,
+    pub kind: JointKind,
+    /// The joint's coordinate.
+    pub coordinate: Option<usize>,
+    /// The unit axis.
+    pub axis: [f64; 3],
+    pub xyz: [Expr<Symbol>; 3],
+    pub rpy: [Expr<Symbol>; 3],
+    pub mass: Expr<Symbol>,
+    pub com: [Expr<Symbol>; 3],
+    pub inertia: [Expr<Symbol>; 6],
+}
+
 /// Resolves every expression of a checked `spec` through `scope`. The
 /// checks have reported every name that stands for nothing and every
 /// definition used before it is defined; `None` if one is met anyway, or
@@ -187,10 +222,29 @@ pub(crate) fn resolve<'a>(spec: &'a ModelSpec, scope: &Scope<'_>) -> Option<Reso
         definitions.push(e);
     }
     let expr = |e: &Expr| e.try_map(&mut |name: &String, _| scope.get(name));
-    let kinetic = expr(spec.kinetic.as_ref()?)?;
+    let kinetic = match &spec.kinetic {
+        Some(k) => Some(expr(k)?),
+        None => None,
+    };
     let potential = match &spec.potential {
         Some(p) => Some(expr(p)?),
         None => None,
+    };
+    let energy_loc = match (&spec.kinetic, spec.bodies_loc) {
+        (Some(k), _) => k.loc,
+        (None, Some(loc)) => loc,
+        (None, None) => return None,
+    };
+    let bodies = tree(spec, scope)?;
+    let gravity = match &spec.gravity {
+        Some([x, y, z]) => [expr(x)?, expr(y)?, expr(z)?],
+        None => {
+            let g = |x: f64| Expr {
+                kind: crate::expr::ExprKind::Num(x),
+                loc: energy_loc,
+            };
+            [g(0.0), g(0.0), g(-9.81)]
+        }
     };
     let mut applied: Vec<Option<Expr<Symbol>>> = vec![None; spec.dofs()];
     for a in &spec.applied {
@@ -219,6 +273,9 @@ pub(crate) fn resolve<'a>(spec: &'a ModelSpec, scope: &Scope<'_>) -> Option<Reso
         definitions,
         kinetic,
         potential,
+        energy_loc,
+        bodies,
+        gravity,
         applied,
         gaps,
         restitution: (0..spec.constraint_count())
@@ -227,6 +284,62 @@ pub(crate) fn resolve<'a>(spec: &'a ModelSpec, scope: &Scope<'_>) -> Option<Reso
         initial_q,
         initial_v,
     })
+}
+
+/// The bodies of a checked spec, parents before children (a stable
+/// topological order: among the bodies whose parent is placed, the first
+/// written comes first). `None` on a cycle or an unknown parent (reported
+/// by the checks).
+fn tree(spec: &ModelSpec, scope: &Scope<'_>) -> Option<Vec<TreeBody>> {
+    let expr = |e: &Expr| e.try_map(&mut |name: &String, _| scope.get(name));
+    let three = |e: &[Expr; 3]| Some([expr(&e[0])?, expr(&e[1])?, expr(&e[2])?]);
+    let parents: Vec<Option<usize>> = spec
+        .bodies
+        .iter()
+        .map(|b| match &b.parent {
+            None => Some(None),
+            Some(p) => match scope.get(&p.text)? {
+                Symbol::Body(j) => Some(Some(j)),
+                _ => None,
+            },
+        })
+        .collect::<Option<_>>()?;
+    let mut placed: Vec<Option<usize>> = vec![None; spec.bodies.len()];
+    let mut order = Vec::with_capacity(spec.bodies.len());
+    while order.len() < spec.bodies.len() {
+        let next = (0..spec.bodies.len())
+            .find(|&i| placed[i].is_none() && parents[i].is_none_or(|p| placed[p].is_some()))?;
+        placed[next] = Some(order.len());
+        order.push(next);
+    }
+    order
+        .into_iter()
+        .map(|i| {
+            let b = &spec.bodies[i];
+            let a = b.joint.axis.map(|n| n.value);
+            let norm = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            let i6 = &b.inertia;
+            Some(TreeBody {
+                index: i,
+                parent: parents[i].map(|p| placed[p].expect("parents are placed first")),
+                kind: b.joint.kind,
+                coordinate: b.joint.coordinate,
+                axis: a.map(|x| x / norm),
+                xyz: three(&b.joint.xyz)?,
+                rpy: three(&b.joint.rpy)?,
+                mass: expr(&b.mass)?,
+                com: three(&b.com)?,
+                inertia: [
+                    expr(&i6[0])?,
+                    expr(&i6[1])?,
+                    expr(&i6[2])?,
+                    expr(&i6[3])?,
+                    expr(&i6[4])?,
+                    expr(&i6[5])?,
+                ],
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]

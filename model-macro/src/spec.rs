@@ -62,11 +62,60 @@ pub(crate) struct Constraint {
     pub doc: Vec<String>,
 }
 
+/// The kind of a body's joint: what its coordinate does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum JointKind {
+    /// A rotation by the coordinate (radians) about the axis.
+    Revolute,
+    /// A translation by the coordinate along the axis.
+    Prismatic,
+    /// No motion: the body is welded to its parent (no coordinate).
+    Fixed,
+}
+
+/// The joint that attaches a body to its parent. Its frame is placed in the
+/// parent's frame by `xyz` then `rpy` (URDF's `<origin>`: the rotation is
+/// `Rz(yaw) Ry(pitch) Rx(roll)`); the body's frame is the joint's frame
+/// moved by the coordinate.
+#[derive(Clone, Debug)]
+pub(crate) struct Joint {
+    pub kind: JointKind,
+    /// The index of its coordinate in `ModelSpec::coordinates` (not for
+    /// fixed joints): the front ends declare one coordinate per moving
+    /// joint.
+    pub coordinate: Option<usize>,
+    /// The axis in the joint's frame, as numbers (normalized when lowered).
+    pub axis: [Number; 3],
+    pub xyz: [Expr; 3],
+    pub rpy: [Expr; 3],
+}
+
+/// A rigid body of the kinematic tree (`bodies`).
+#[derive(Clone, Debug)]
+pub(crate) struct Body {
+    pub name: Name,
+    /// The parent body; `None` for the world (the fixed base).
+    pub parent: Option<Name>,
+    pub joint: Joint,
+    pub mass: Expr,
+    /// The centre of mass in the body's frame.
+    pub com: [Expr; 3],
+    /// The inertia about the centre of mass, in the body's frame:
+    /// `ixx, ixy, ixz, iyy, iyz, izz`.
+    pub inertia: [Expr; 6],
+}
+
 /// Where the model was written.
 #[derive(Clone, Debug)]
 pub(crate) enum Origin {
-    /// A YAML file: its absolute path (for `include_bytes!`) and its text.
-    Yaml { path: String, text: String },
+    /// A YAML file: its absolute path (for `include_bytes!`), its text,
+    /// and the absolute paths of the other files it reads (a URDF), also
+    /// tracked so that editing them rebuilds the model.
+    Yaml {
+        path: String,
+        text: String,
+        reads: Vec<String>,
+    },
     /// Inline tokens.
     Inline,
 }
@@ -89,6 +138,13 @@ pub(crate) struct ModelSpec {
     pub constraints: Vec<Constraint>,
     pub restitution: Option<Number>,
     pub initial: Vec<(Name, Number)>,
+    /// The kinematic tree (`bodies`), in the order written.
+    pub bodies: Vec<Body>,
+    /// The gravity vector of the tree's potential energy (`gravity`);
+    /// `None` is `[0, 0, -9.81]`.
+    pub gravity: Option<[Expr; 3]>,
+    /// Where `bodies` was written (for messages about the tree as a whole).
+    pub bodies_loc: Option<Loc>,
     pub origin: Origin,
 }
 
@@ -160,5 +216,6 @@ impl ModelSpec {
             .chain(self.parameters.iter().map(|p| (&p.name, "a parameter")))
             .chain(self.inputs.iter().map(|i| (i, "an input")))
             .chain(self.definitions.iter().map(|d| (&d.name, "a definition")))
+            .chain(self.bodies.iter().map(|b| (&b.name, "a body")))
     }
 }

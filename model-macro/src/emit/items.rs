@@ -43,7 +43,9 @@ impl Emitter<'_, '_> {
     pub(super) fn items(&self) -> TokenStream {
         let strukt = self.struct_item();
         let tracking = match &self.model.spec.origin {
-            Origin::Yaml { path, .. } => quote! { const _: &[u8] = ::core::include_bytes!(#path); },
+            Origin::Yaml { path, reads, .. } => {
+                quote! { #(const _: &[u8] = ::core::include_bytes!(#reads);)* const _: &[u8] = ::core::include_bytes!(#path); }
+            }
             Origin::Inline => TokenStream::new(),
         };
         let inherent = self.inherent_items();

@@ -8,6 +8,10 @@
 //! atom  := number | name | name '(' expr (',' expr)* ')' | '(' expr ')'
 //! ```
 //!
+//! Two calls are not elementary functions: `position_x(body, x, y, z)`
+//! (and `_y`, `_z`) is a world coordinate of the point `[x, y, z]` of a
+//! body's frame, and `position_x(body)` that of the frame's origin.
+//!
 //! This is the grammar's one statement; `models/README.md` and the CasADi
 //! reference parser (`tests/casadi_reference.py`) point here. The functions
 //! are `moreau_sym::Function::ALL`.
@@ -86,7 +90,15 @@ pub(crate) enum ExprKind<N> {
     Func(Func, Box<Expr<N>>),
     /// `atan2(y, x)`.
     Atan2(Box<Expr<N>>, Box<Expr<N>>),
+    /// One world coordinate (0: x, 1: y, 2: z) of a point fixed in a body,
+    /// given in the body's frame: `position_z(hand, 0, 0, 0.1)`. The body is
+    /// a name like any other (bodies share the one namespace); resolution
+    /// checks that it names a body.
+    Position(usize, N, Box<[Expr<N>; 3]>),
 }
+
+/// The functions that give a point's world position, by axis.
+pub(crate) const POSITION_FUNCTIONS: [&str; 3] = ["position_x", "position_y", "position_z"];
 
 impl<N> Expr<N> {
     /// Calls `f` on every name this expression uses, in reading order.
@@ -98,6 +110,10 @@ impl<N> Expr<N> {
             ExprKind::Binary(_, a, b) | ExprKind::Atan2(a, b) => {
                 a.visit(f);
                 b.visit(f);
+            }
+            ExprKind::Position(_, body, point) => {
+                f(body, self.loc);
+                point.iter().for_each(|c| c.visit(f));
             }
         }
     }
@@ -118,6 +134,12 @@ impl<N> Expr<N> {
             ExprKind::Atan2(a, b) => {
                 let (a, b) = (a.try_map(f), b.try_map(f));
                 ExprKind::Atan2(Box::new(a?), Box::new(b?))
+            }
+            ExprKind::Position(axis, body, point) => {
+                let body = f(body, self.loc);
+                let [x, y, z] = &**point;
+                let (x, y, z) = (x.try_map(f), y.try_map(f), z.try_map(f));
+                ExprKind::Position(*axis, body?, Box::new([x?, y?, z?]))
             }
         };
         Some(Expr {
@@ -162,6 +184,11 @@ impl fmt::Display for Expr {
             }
             ExprKind::Func(func, a) => write!(f, "{func}({a})"),
             ExprKind::Atan2(y, x) => write!(f, "atan2({y}, {x})"),
+            ExprKind::Position(axis, body, p) => write!(
+                f,
+                "{}({body}, {}, {}, {})",
+                POSITION_FUNCTIONS[*axis], p[0], p[1], p[2]
+            ),
         }
     }
 }

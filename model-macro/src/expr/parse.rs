@@ -194,6 +194,9 @@ impl Parser<'_> {
             args.push(self.expr()?);
         }
         self.close(loc)?;
+        if let Some(axis) = super::POSITION_FUNCTIONS.iter().position(|f| *f == name) {
+            return self.position(axis, &name, args, loc);
+        }
         let Some(func) = func else {
             let names: Vec<&str> = Function::ALL.iter().map(|f| f.name()).collect();
             self.cx.error(
@@ -221,6 +224,39 @@ impl Parser<'_> {
             },
         };
         Some(Expr { kind, loc })
+    }
+
+    /// `position_x(body)` or `position_x(body, x, y, z)`.
+    fn position(&mut self, axis: usize, name: &str, args: Vec<Expr>, loc: Loc) -> Option<Expr> {
+        let zero = || Expr {
+            kind: ExprKind::Num(0.0),
+            loc,
+        };
+        let mut args = args.into_iter();
+        let body = args.next()?;
+        let point: Vec<Expr> = args.collect();
+        let point = match point.len() {
+            0 => [zero(), zero(), zero()],
+            3 => <[Expr; 3]>::try_from(point).ok()?,
+            found => {
+                self.cx.error(
+                    loc,
+                    format!("`{name}` takes a body and, optionally, the point's three coordinates in the body's frame (`{name}(body, x, y, z)`); found {} argument{}", found + 1, if found == 0 { "" } else { "s" }),
+                );
+                return None;
+            }
+        };
+        let ExprKind::Name(body_name) = body.kind else {
+            self.cx.error(
+                body.loc,
+                format!("the first argument of `{name}` is the name of a body"),
+            );
+            return None;
+        };
+        Some(Expr {
+            kind: ExprKind::Position(axis, body_name, Box::new(point)),
+            loc,
+        })
     }
 
     fn arity_error(&self, func: Function, found: usize, loc: Loc) -> Option<Expr> {

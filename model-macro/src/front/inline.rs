@@ -67,6 +67,9 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         constraints: Vec::new(),
         restitution: None,
         initial: Vec::new(),
+        bodies: Vec::new(),
+        gravity: None,
+        bodies_loc: None,
         origin: Origin::Inline,
     };
     let mut seen: Vec<String> = Vec::new();

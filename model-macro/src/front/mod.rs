@@ -2,5 +2,6 @@
 //! neither checks more than the shape of what it reads.
 
 pub(crate) mod inline;
+pub(crate) mod urdf;
 pub(crate) mod yaml;
 pub(crate) mod yaml_tree;

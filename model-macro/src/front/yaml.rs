@@ -17,7 +17,8 @@ use crate::keys;
 use crate::loc::Loc;
 use crate::loc::YamlPos;
 use crate::spec::{
-    Applied, Constraint, Coordinate, Definition, ModelSpec, Name, Number, Origin, Parameter,
+    Applied, Body, Constraint, Coordinate, Definition, Joint, JointKind, ModelSpec, Name, Number,
+    Origin, Parameter,
 };
 
 /// The arguments of the file form: `file = "path"`.
@@ -47,8 +48,13 @@ impl syn::parse::Parse for FileArgs {
 /// Finds and reads the model file. Errors (missing, unreadable, outside the
 /// crate) point at the path literal.
 pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
-    let span = args.path.span();
-    let relative = args.path.value();
+    read_file(&args.path.value(), args.path.span(), "model file")
+}
+
+/// Reads the file at `relative` (to the crate's directory, and inside it);
+/// `what` names it in messages.
+fn read_file(relative: &str, span: Span, what: &str) -> syn::Result<(YamlSource, PathBuf)> {
+    let relative = relative.to_string();
     let manifest = std::env::var("CARGO_MANIFEST_DIR")
         .map_err(|_| syn::Error::new(span, "CARGO_MANIFEST_DIR is not set; build with cargo"))?;
     let root = Path::new(&manifest).canonicalize().map_err(|e| {
@@ -61,7 +67,7 @@ pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
         syn::Error::new(
             span,
             format!(
-                "cannot read model file `{relative}` (paths are relative to the crate's directory): {e}"
+                "cannot read {what} `{relative}` (paths are relative to the crate's directory): {e}"
             ),
         )
     })?;
@@ -69,12 +75,12 @@ pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
         return Err(syn::Error::new(
             span,
             format!(
-                "model file `{relative}` is outside this crate; keep model files inside the crate's directory"
+                "{what} `{relative}` is outside this crate; keep model files inside the crate's directory"
             ),
         ));
     }
     let text = std::fs::read_to_string(&path)
-        .map_err(|e| syn::Error::new(span, format!("cannot read model file `{relative}`: {e}")))?;
+        .map_err(|e| syn::Error::new(span, format!("cannot read {what} `{relative}`: {e}")))?;
     Ok((
         YamlSource {
             display: relative,
@@ -133,28 +139,65 @@ pub(crate) fn build(
         constraints: Vec::new(),
         restitution: None,
         initial: Vec::new(),
+        bodies: Vec::new(),
+        gravity: None,
+        bodies_loc: None,
         origin: Origin::Yaml {
             path: path.display().to_string(),
             text,
+            reads: Vec::new(),
         },
     };
     let mut seen: Vec<&str> = Vec::new();
+    let (mut urdf, mut locked): (Option<(Name, &YNode)>, Vec<Name>) = (None, Vec::new());
     for (key, value) in entries {
         let Some(k) = w.key(key) else { continue };
         if let Some(first) = seen.iter().find(|s| **s == k.text) {
             cx.error(k.loc, format!("duplicate key `{first}`"));
             continue;
         }
-        if let Some(known) = w.top_level(&mut spec, &k, value) {
-            seen.push(known);
+        match k.text.as_str() {
+            // Read after the other keys, whatever their order.
+            keys::URDF => {
+                if let Some(path) = w.name(value, "the URDF file's path") {
+                    urdf = Some((path, value));
+                }
+                seen.push(keys::URDF);
+            }
+            keys::LOCKED => {
+                match &value.kind {
+                    YKind::Seq(items) => {
+                        locked = items
+                            .iter()
+                            .filter_map(|i| w.name(i, "a locked joint"))
+                            .collect();
+                    }
+                    _ => w.expected(value, "a list of joint names, like `[finger1, finger2]`"),
+                }
+                seen.push(keys::LOCKED);
+            }
+            _ => {
+                if let Some(known) = w.top_level(&mut spec, &k, value) {
+                    seen.push(known);
+                }
+            }
         }
     }
+    if let Some((urdf, node)) = urdf {
+        w.import_urdf(&mut spec, &urdf, node, &locked);
+    } else if let Some(first) = locked.first() {
+        cx.error(
+            first.loc,
+            "`locked` names joints of a URDF, but this model has no `urdf`",
+        );
+    }
+    let has_bodies = seen.contains(&keys::BODIES) || seen.contains(&keys::URDF);
     for (key, what) in [
         (keys::NAME, "its name"),
-        (keys::COORDINATES, "its coordinates"),
-        (keys::KINETIC, "its kinetic energy"),
+        (keys::COORDINATES, "its coordinates (or `bodies`)"),
+        (keys::KINETIC, "its kinetic energy (or `bodies`)"),
     ] {
-        if !seen.contains(&key) {
+        if !seen.contains(&key) && (key == keys::NAME || !has_bodies) {
             cx.error(
                 w.loc(root),
                 format!("missing `{key}`: a model needs {what}"),
@@ -171,6 +214,41 @@ struct Walker<'a> {
 }
 
 impl Walker<'_> {
+    /// Reads the URDF named by `urdf:` and appends its bodies and joint
+    /// coordinates to `spec`; its problems are reported at the `urdf:`
+    /// value, each message starting with the URDF's `path:line:column`.
+    fn import_urdf(&self, spec: &mut ModelSpec, path: &Name, node: &YNode, locked: &[Name]) {
+        let loc = self.loc(node);
+        let (source, absolute) = match read_file(&path.text, self.span, "URDF file") {
+            Ok(read) => read,
+            Err(e) => {
+                self.cx.error(loc, e.to_string());
+                return;
+            }
+        };
+        if let Origin::Yaml { reads, .. } = &mut spec.origin {
+            reads.push(absolute.display().to_string());
+        }
+        match super::urdf::import(&source.display, &source.text, loc, locked) {
+            Ok(imported) => {
+                let shift = spec.coordinates.len();
+                spec.coordinates.extend(imported.coordinates);
+                for mut b in imported.bodies {
+                    if let Some(c) = &mut b.joint.coordinate {
+                        *c += shift;
+                    }
+                    spec.bodies.push(b);
+                }
+                spec.bodies_loc.get_or_insert(loc);
+            }
+            Err(messages) => {
+                for m in messages {
+                    self.cx.error(loc, m);
+                }
+            }
+        }
+    }
+
     /// `parameters:`, a mapping of names to default values.
     fn parameters(&self, value: &YNode) -> Vec<Parameter> {
         let w = self;
@@ -201,7 +279,24 @@ impl Walker<'_> {
                 Some(doc) => spec.doc = doc.lines().map(str::to_string).collect(),
                 None => w.expected(value, "a text for `doc`"),
             },
-            keys::COORDINATES => spec.coordinates = w.coordinates(value),
+            keys::COORDINATES => {
+                // Joint coordinates (when `bodies` came first) go after
+                // the written ones.
+                let mut written = w.coordinates(value);
+                let shift = written.len();
+                for b in &mut spec.bodies {
+                    if let Some(c) = &mut b.joint.coordinate {
+                        *c += shift;
+                    }
+                }
+                written.append(&mut spec.coordinates);
+                spec.coordinates = written;
+            }
+            keys::BODIES => {
+                spec.bodies_loc = Some(w.loc(value));
+                w.bodies(spec, value);
+            }
+            keys::GRAVITY => spec.gravity = w.vector(value, "`gravity`"),
             keys::PARAMETERS => spec.parameters = w.parameters(value),
             keys::INPUTS => match &value.kind {
                 YKind::Seq(items) => {
@@ -371,6 +466,273 @@ impl Walker<'_> {
                 }
             })
             .collect()
+    }
+
+    /// `[x, y, z]`: three expressions.
+    fn vector(&self, node: &YNode, what: &str) -> Option<[Expr; 3]> {
+        match &node.kind {
+            YKind::Seq(items) if items.len() == 3 => {
+                let (x, y, z) = (
+                    self.expr(&items[0]),
+                    self.expr(&items[1]),
+                    self.expr(&items[2]),
+                );
+                Some([x?, y?, z?])
+            }
+            _ => {
+                self.expected(
+                    node,
+                    &format!("three numbers or expressions `[x, y, z]` for {what}"),
+                );
+                None
+            }
+        }
+    }
+
+    /// `bodies:`, a list of bodies; each moving joint appends its
+    /// coordinate to `spec.coordinates`.
+    fn bodies(&self, spec: &mut ModelSpec, node: &YNode) {
+        let YKind::Seq(items) = &node.kind else {
+            self.expected(
+                node,
+                "a list of bodies (`- name: ..., parent: ..., joint: ...`)",
+            );
+            return;
+        };
+        for item in items {
+            if let Some(body) = self.body(spec, item) {
+                spec.bodies.push(body);
+            }
+        }
+    }
+
+    fn body(&self, spec: &mut ModelSpec, item: &YNode) -> Option<Body> {
+        let YKind::Map(entries) = &item.kind else {
+            self.expected(
+                item,
+                "a body with `name`, `joint`, `mass`, `com` and `inertia`",
+            );
+            return None;
+        };
+        let zero = |loc| Expr {
+            kind: crate::expr::ExprKind::Num(0.0),
+            loc,
+        };
+        let here = self.loc(item);
+        let (mut name, mut parent, mut joint, mut mass) = (None, None, None, None);
+        let (mut com, mut inertia) = (None, None);
+        let mut ok = true;
+        for (key, value) in entries {
+            let Some(k) = self.key(key) else { continue };
+            match k.text.as_str() {
+                keys::NAME => name = self.name(value, "the body"),
+                keys::PARENT => {
+                    parent = self.name(value, "the parent body (or `world`)");
+                    ok &= parent.is_some();
+                }
+                keys::JOINT => {
+                    joint = self.joint(spec, value);
+                    ok &= joint.is_some();
+                }
+                keys::MASS => {
+                    mass = self.expr(value);
+                    ok &= mass.is_some();
+                }
+                keys::COM => {
+                    com = self.vector(value, "`com`");
+                    ok &= com.is_some();
+                }
+                keys::INERTIA => {
+                    inertia = self.inertia(value);
+                    ok &= inertia.is_some();
+                }
+                other => self.cx.error(
+                    k.loc,
+                    format!(
+                        "unknown key `{other}` in a body; a body has {}",
+                        keys::BODY_KEYS.join(", ")
+                    ),
+                ),
+            }
+        }
+        for (missing, key) in [
+            (name.is_none(), keys::NAME),
+            (joint.is_none() && ok, keys::JOINT),
+            (mass.is_none() && ok, keys::MASS),
+        ] {
+            if missing {
+                self.cx.error(here, format!("missing `{key}` in this body"));
+            }
+        }
+        Some(Body {
+            name: name?,
+            parent: parent.filter(|p| p.text != keys::WORLD),
+            joint: joint?,
+            mass: mass?,
+            com: com.unwrap_or_else(|| [zero(here), zero(here), zero(here)]),
+            inertia: inertia.unwrap_or_else(|| std::array::from_fn(|_| zero(here))),
+        })
+    }
+
+    /// `inertia: [ixx, ixy, ixz, iyy, iyz, izz]`.
+    fn inertia(&self, node: &YNode) -> Option<[Expr; 6]> {
+        match &node.kind {
+            YKind::Seq(items) if items.len() == 6 => {
+                let all: Vec<Option<Expr>> = items.iter().map(|i| self.expr(i)).collect();
+                let all: Vec<Expr> = all.into_iter().collect::<Option<_>>()?;
+                <[Expr; 6]>::try_from(all).ok()
+            }
+            _ => {
+                self.expected(
+                    node,
+                    "six numbers or expressions `[ixx, ixy, ixz, iyy, iyz, izz]` for `inertia`",
+                );
+                None
+            }
+        }
+    }
+
+    /// A body's `joint:` mapping; a moving joint declares its coordinate.
+    fn joint(&self, spec: &mut ModelSpec, node: &YNode) -> Option<Joint> {
+        let YKind::Map(entries) = &node.kind else {
+            self.expected(
+                node,
+                "a joint (`{type: revolute, name: q1, axis: [0, 0, 1]}`)",
+            );
+            return None;
+        };
+        let here = self.loc(node);
+        let zero = || Expr {
+            kind: crate::expr::ExprKind::Num(0.0),
+            loc: here,
+        };
+        let (mut kind, mut name, mut velocity, mut axis) = (None, None, None, None);
+        let (mut xyz, mut rpy) = (None, None);
+        let mut ok = true;
+        for (key, value) in entries {
+            let Some(k) = self.key(key) else { continue };
+            match k.text.as_str() {
+                keys::TYPE => {
+                    kind = match value.scalar_text().as_deref() {
+                        Some("revolute") => Some(JointKind::Revolute),
+                        Some("prismatic") => Some(JointKind::Prismatic),
+                        Some("fixed") => Some(JointKind::Fixed),
+                        _ => {
+                            self.expected(
+                                value,
+                                &format!("a joint type ({})", keys::JOINT_TYPES.join(", ")),
+                            );
+                            ok = false;
+                            None
+                        }
+                    }
+                }
+                keys::NAME => name = self.name(value, "the joint's coordinate"),
+                keys::VELOCITY => velocity = self.name(value, "the joint's velocity"),
+                keys::AXIS => {
+                    axis = self.axis(value);
+                    ok &= axis.is_some();
+                }
+                keys::XYZ => {
+                    xyz = self.vector(value, "`xyz`");
+                    ok &= xyz.is_some();
+                }
+                keys::RPY => {
+                    rpy = self.vector(value, "`rpy`");
+                    ok &= rpy.is_some();
+                }
+                other => self.cx.error(
+                    k.loc,
+                    format!(
+                        "unknown key `{other}` in a joint; a joint has {}",
+                        keys::JOINT_KEYS.join(", ")
+                    ),
+                ),
+            }
+        }
+        if kind.is_none() && ok {
+            self.cx.error(
+                here,
+                format!(
+                    "missing `type` in this joint ({})",
+                    keys::JOINT_TYPES.join(", ")
+                ),
+            );
+        }
+        let kind = kind?;
+        let coordinate = match (kind, name) {
+            (JointKind::Fixed, Some(n)) => {
+                self.cx
+                    .error(n.loc, "a fixed joint has no coordinate to name");
+                None
+            }
+            (JointKind::Fixed, None) => None,
+            (_, None) => {
+                self.cx
+                    .error(here, "missing `name` in this joint: its coordinate's name");
+                return None;
+            }
+            (_, Some(q)) => {
+                let v = velocity.clone().unwrap_or_else(|| Name {
+                    text: format!("d{}", q.text),
+                    loc: q.loc,
+                });
+                spec.coordinates.push(Coordinate { q, v });
+                Some(spec.coordinates.len() - 1)
+            }
+        };
+        if let (JointKind::Fixed, Some(v)) = (kind, &velocity) {
+            self.cx
+                .error(v.loc, "a fixed joint has no velocity to name");
+        }
+        let unit = |value| Number { value, loc: here };
+        let axis = match (kind, axis) {
+            (JointKind::Fixed, _) => [unit(0.0), unit(0.0), unit(1.0)],
+            (_, Some(a)) => a,
+            (_, None) => {
+                if ok {
+                    self.cx.error(here, "missing `axis` in this joint");
+                }
+                return None;
+            }
+        };
+        Some(Joint {
+            kind,
+            coordinate,
+            axis,
+            xyz: xyz.unwrap_or_else(|| [zero(), zero(), zero()]),
+            rpy: rpy.unwrap_or_else(|| [zero(), zero(), zero()]),
+        })
+    }
+
+    /// A joint's axis: three numbers, not all zero.
+    fn axis(&self, node: &YNode) -> Option<[Number; 3]> {
+        let numbers = match &node.kind {
+            YKind::Seq(items) if items.len() == 3 => {
+                let all: Vec<Option<Number>> = items
+                    .iter()
+                    .map(|i| self.number(i, "an axis component"))
+                    .collect();
+                all.into_iter().collect::<Option<Vec<_>>>()?
+            }
+            _ => {
+                self.expected(node, "three numbers `[x, y, z]` for `axis`");
+                return None;
+            }
+        };
+        let norm = numbers
+            .iter()
+            .map(|n| n.value * n.value)
+            .sum::<f64>()
+            .sqrt();
+        if !(norm.is_finite() && norm > 0.0) {
+            self.cx.error(
+                self.loc(node),
+                "a joint's axis must be a finite, non-zero vector",
+            );
+            return None;
+        }
+        <[Number; 3]>::try_from(numbers).ok()
     }
 
     fn constraints(&self, node: &YNode) -> Vec<Constraint> {

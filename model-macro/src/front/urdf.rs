@@ -1,0 +1,384 @@
+//! URDF import: a model file's `urdf: path` key names a URDF whose links
+//! and joints become the model's `bodies` (see `models/README.md`).
+//!
+//! The XML is read with `roxmltree`. The mapping, for a fixed base:
+//!
+//! - the root link (the one that is no joint's child) is the world: the
+//!   bodies attached to it have the parent `world`, and it has no body (its
+//!   mass would only add a constant to `V`);
+//! - every other link is a body named as the link, attached by the joint
+//!   whose child it is: `revolute` and `continuous` become revolute joints,
+//!   `prismatic` prismatic, `fixed` fixed; the joint's `<origin>` is the
+//!   body's `xyz` and `rpy`, its `<axis>` (default `1 0 0`) the axis, its
+//!   name the coordinate's (the velocity is `d<name>`);
+//! - the link's `<inertial>`: `mass`, `origin xyz` as the centre of mass and
+//!   the inertia rotated by `origin rpy` into the link's frame
+//!   (`R I Rᵀ`), computed here in `f64`;
+//! - joints listed in the model's `locked` are held at zero: they become
+//!   fixed joints (Pinocchio's `buildReducedModel` at the zero
+//!   configuration).
+//!
+//! `floating` and `planar` joints are refused with an error that says why,
+//! as are `mimic` joints that are not locked; every problem in the file is
+//! reported at once, each with the URDF's `path:line:column`.
+
+use std::collections::HashMap;
+
+use crate::expr::{Expr, ExprKind};
+use crate::loc::Loc;
+use crate::spec::{Body, Coordinate, Joint, JointKind, Name, Number};
+
+/// A joint or link of the URDF, as read.
+struct UrdfJoint<'a> {
+    name: &'a str,
+    kind: JointKind,
+    parent: &'a str,
+    child: &'a str,
+    xyz: [f64; 3],
+    rpy: [f64; 3],
+    axis: [f64; 3],
+}
+
+#[derive(Default, Clone, Copy)]
+struct Inertial {
+    mass: f64,
+    com: [f64; 3],
+    /// `ixx, ixy, ixz, iyy, iyz, izz` in the link's frame.
+    inertia: [f64; 6],
+}
+
+/// What the URDF gives the model: its bodies (parents before children, in
+/// the depth-first order of the tree, children in the order of the file)
+/// and one coordinate per moving joint, in the same order.
+pub(crate) struct Imported {
+    pub bodies: Vec<Body>,
+    pub coordinates: Vec<Coordinate>,
+}
+
+/// Reads the URDF `text` (shown in messages as `display`). Every problem is
+/// returned as a message that starts with `display:line:column`; `loc` is
+/// where the model names the file, and every imported name and number
+/// points there. `locked` names joints to hold at zero; the ones the file
+/// does not have are reported.
+pub(crate) fn import(
+    display: &str,
+    text: &str,
+    loc: Loc,
+    locked: &[Name],
+) -> Result<Imported, Vec<String>> {
+    let doc = roxmltree::Document::parse(text).map_err(|e| {
+        let pos = e.pos();
+        vec![format!(
+            "{display}:{}:{}: malformed URDF: {e}",
+            pos.row, pos.col
+        )]
+    })?;
+    let mut errors = Vec::new();
+    let at = |node: roxmltree::Node<'_, '_>| {
+        let pos = doc.text_pos_at(node.range().start);
+        format!("{display}:{}:{}", pos.row, pos.col)
+    };
+    let root = doc.root_element();
+    if root.tag_name().name() != "robot" {
+        return Err(vec![format!(
+            "{}: a URDF's root element is <robot>, found <{}>",
+            at(root),
+            root.tag_name().name()
+        )]);
+    }
+    let mut links: Vec<(&str, Inertial)> = Vec::new();
+    let mut joints: Vec<UrdfJoint<'_>> = Vec::new();
+    for node in root.children().filter(|n| n.is_element()) {
+        match node.tag_name().name() {
+            "link" => {
+                let Some(name) = attribute(node, "name", &at, &mut errors) else {
+                    continue;
+                };
+                let inertial = inertial(node, &at, &mut errors);
+                links.push((name, inertial));
+            }
+            "joint" => {
+                if let Some(j) = joint(node, locked, &at, &mut errors) {
+                    joints.push(j);
+                }
+            }
+            _ => {}
+        }
+    }
+    for l in locked {
+        if !joints.iter().any(|j| j.name == l.text) {
+            errors.push(format!(
+                "{display}: `locked` names the joint `{}`, which this URDF does not have",
+                l.text
+            ));
+        }
+    }
+    let inertials: HashMap<&str, Inertial> = links.iter().copied().collect();
+    let mut child_of: HashMap<&str, usize> = HashMap::new();
+    for (i, j) in joints.iter().enumerate() {
+        for link in [j.parent, j.child] {
+            if !inertials.contains_key(link) {
+                errors.push(format!(
+                    "{display}: joint `{}` names the link `{link}`, which this URDF does not have",
+                    j.name
+                ));
+            }
+        }
+        if child_of.insert(j.child, i).is_some() {
+            errors.push(format!(
+                "{display}: link `{}` is the child of two joints: a URDF is a tree",
+                j.child
+            ));
+        }
+    }
+    let roots: Vec<&str> = links
+        .iter()
+        .map(|(name, _)| *name)
+        .filter(|name| !child_of.contains_key(name))
+        .collect();
+    if roots.len() != 1 && errors.is_empty() {
+        errors.push(format!(
+            "{display}: a URDF has one root link (a link that is no joint's child), found {}: {}",
+            roots.len(),
+            roots.join(", ")
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    // Depth-first from the root, children in the order of the file.
+    let mut imported = Imported {
+        bodies: Vec::new(),
+        coordinates: Vec::new(),
+    };
+    let mut stack: Vec<(usize, Option<&str>)> = joints
+        .iter()
+        .enumerate()
+        .rev()
+        .filter(|(_, j)| j.parent == roots[0])
+        .map(|(i, _)| (i, None))
+        .collect();
+    let number = |value: f64| Expr {
+        kind: ExprKind::Num(value),
+        loc,
+    };
+    let three = |v: [f64; 3]| v.map(number);
+    let name = |text: &str| Name {
+        text: text.to_string(),
+        loc,
+    };
+    while let Some((i, parent)) = stack.pop() {
+        let j = &joints[i];
+        let coordinate = (j.kind != JointKind::Fixed).then(|| {
+            imported.coordinates.push(Coordinate {
+                q: name(j.name),
+                v: name(&format!("d{}", j.name)),
+            });
+            imported.coordinates.len() - 1
+        });
+        let inertial = inertials[j.child];
+        imported.bodies.push(Body {
+            name: name(j.child),
+            parent: parent.map(name),
+            joint: Joint {
+                kind: j.kind,
+                coordinate,
+                axis: j.axis.map(|value| Number { value, loc }),
+                xyz: three(j.xyz),
+                rpy: three(j.rpy),
+            },
+            mass: number(inertial.mass),
+            com: three(inertial.com),
+            inertia: inertial.inertia.map(number),
+        });
+        stack.extend(
+            joints
+                .iter()
+                .enumerate()
+                .rev()
+                .filter(|(_, c)| c.parent == j.child)
+                .map(|(c, _)| (c, Some(j.child))),
+        );
+        if stack.len() > joints.len() {
+            // Only a cycle can push more joints than there are.
+            return Err(vec![format!(
+                "{display}: the joints form a cycle through link `{}`: a URDF is a tree",
+                j.child
+            )]);
+        }
+    }
+    Ok(imported)
+}
+
+fn attribute<'a>(
+    node: roxmltree::Node<'a, '_>,
+    key: &str,
+    at: &dyn Fn(roxmltree::Node<'_, '_>) -> String,
+    errors: &mut Vec<String>,
+) -> Option<&'a str> {
+    let value = node.attribute(key);
+    if value.is_none() {
+        errors.push(format!(
+            "{}: <{}> has no `{key}` attribute",
+            at(node),
+            node.tag_name().name()
+        ));
+    }
+    value
+}
+
+/// The first child element called `tag`.
+fn child<'a, 'i>(node: roxmltree::Node<'a, 'i>, tag: &str) -> Option<roxmltree::Node<'a, 'i>> {
+    node.children()
+        .find(|c| c.is_element() && c.tag_name().name() == tag)
+}
+
+/// The numbers of attribute `key` of `node` (`xyz="0 0 0.1"`), `default`
+/// when the node or attribute is absent.
+fn numbers<const K: usize>(
+    node: Option<roxmltree::Node<'_, '_>>,
+    key: &str,
+    default: [f64; K],
+    at: &dyn Fn(roxmltree::Node<'_, '_>) -> String,
+    errors: &mut Vec<String>,
+) -> [f64; K] {
+    let Some(node) = node else { return default };
+    let Some(text) = node.attribute(key) else {
+        return default;
+    };
+    let parsed: Result<Vec<f64>, _> = text.split_whitespace().map(str::parse::<f64>).collect();
+    match parsed {
+        Ok(v) if v.len() == K && v.iter().all(|x| x.is_finite()) => {
+            <[f64; K]>::try_from(v).unwrap_or(default)
+        }
+        _ => {
+            errors.push(format!(
+                "{}: `{key}=\"{text}\"` is not {K} finite number{}",
+                at(node),
+                if K == 1 { "" } else { "s" }
+            ));
+            default
+        }
+    }
+}
+
+fn inertial(
+    link: roxmltree::Node<'_, '_>,
+    at: &dyn Fn(roxmltree::Node<'_, '_>) -> String,
+    errors: &mut Vec<String>,
+) -> Inertial {
+    let Some(node) = child(link, "inertial") else {
+        return Inertial::default();
+    };
+    let origin = child(node, "origin");
+    let com = numbers(origin, "xyz", [0.0; 3], at, errors);
+    let rpy = numbers(origin, "rpy", [0.0; 3], at, errors);
+    let [mass] = numbers(child(node, "mass"), "value", [0.0], at, errors);
+    let inertia = child(node, "inertia");
+    let mut i = [0.0; 6];
+    for (slot, key) in i.iter_mut().zip(["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]) {
+        [*slot] = numbers(inertia, key, [0.0], at, errors);
+    }
+    if mass < 0.0 {
+        errors.push(format!("{}: a link's mass cannot be negative", at(node)));
+    }
+    Inertial {
+        mass,
+        com,
+        inertia: rotate_inertia(i, rpy),
+    }
+}
+
+/// `R I Rᵀ` with `R = Rz(yaw) Ry(pitch) Rx(roll)`.
+fn rotate_inertia([xx, xy, xz, yy, yz, zz]: [f64; 6], [r, p, y]: [f64; 3]) -> [f64; 6] {
+    let (sr, cr) = r.sin_cos();
+    let (sp, cp) = p.sin_cos();
+    let (sy, cy) = y.sin_cos();
+    let rot = [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ];
+    let i = [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]];
+    let mut out = [[0.0; 3]; 3];
+    for (a, row) in out.iter_mut().enumerate() {
+        for (b, cell) in row.iter_mut().enumerate() {
+            for k in 0..3 {
+                for l in 0..3 {
+                    *cell += rot[a][k] * i[k][l] * rot[b][l];
+                }
+            }
+        }
+    }
+    [
+        out[0][0], out[0][1], out[0][2], out[1][1], out[1][2], out[2][2],
+    ]
+}
+
+fn joint<'a>(
+    node: roxmltree::Node<'a, '_>,
+    locked: &[Name],
+    at: &dyn Fn(roxmltree::Node<'_, '_>) -> String,
+    errors: &mut Vec<String>,
+) -> Option<UrdfJoint<'a>> {
+    let name = attribute(node, "name", at, errors);
+    let kind = attribute(node, "type", at, errors);
+    let parent = child(node, "parent")
+        .ok_or(())
+        .map_err(|()| errors.push(format!("{}: <joint> has no <parent>", at(node))))
+        .ok()
+        .and_then(|p| attribute(p, "link", at, errors));
+    let child_link = child(node, "child")
+        .ok_or(())
+        .map_err(|()| errors.push(format!("{}: <joint> has no <child>", at(node))))
+        .ok()
+        .and_then(|c| attribute(c, "link", at, errors));
+    let origin = child(node, "origin");
+    let xyz = numbers(origin, "xyz", [0.0; 3], at, errors);
+    let rpy = numbers(origin, "rpy", [0.0; 3], at, errors);
+    let axis = numbers(child(node, "axis"), "xyz", [1.0, 0.0, 0.0], at, errors);
+    let (name, kind) = (name?, kind?);
+    let is_locked = locked.iter().any(|l| l.text == name);
+    let kind = match kind {
+        _ if is_locked => JointKind::Fixed,
+        "revolute" | "continuous" => JointKind::Revolute,
+        "prismatic" => JointKind::Prismatic,
+        "fixed" => JointKind::Fixed,
+        "floating" | "planar" => {
+            errors.push(format!(
+                "{}: joint `{name}` is {kind}: a {kind} base is not supported (a fixed base only; write a planar or spatial base as explicit prismatic and revolute joints, or lock it with `locked`)",
+                at(node)
+            ));
+            return None;
+        }
+        other => {
+            errors.push(format!(
+                "{}: joint `{name}` has the unknown type `{other}` (revolute, continuous, prismatic, fixed)",
+                at(node)
+            ));
+            return None;
+        }
+    };
+    if let Some(m) = child(node, "mimic")
+        && !is_locked
+    {
+        errors.push(format!(
+            "{}: joint `{name}` mimics another joint, which is not supported: lock it (`locked: [{name}]`)",
+            at(m)
+        ));
+        return None;
+    }
+    if kind != JointKind::Fixed && axis.iter().all(|a| *a == 0.0) {
+        errors.push(format!("{}: joint `{name}` has a zero axis", at(node)));
+        return None;
+    }
+    Some(UrdfJoint {
+        name,
+        kind,
+        parent: parent?,
+        child: child_link?,
+        xyz,
+        rpy,
+        axis,
+    })
+}

@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/bodies_joints.yaml");
+
+fn main() {}

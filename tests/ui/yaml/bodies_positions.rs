@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/bodies_positions.yaml");
+
+fn main() {}

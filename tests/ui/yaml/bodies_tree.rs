@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/bodies_tree.yaml");
+
+fn main() {}
