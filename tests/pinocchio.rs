@@ -1,6 +1,7 @@
-//! URDF models against Pinocchio: `tests/robots/ur5.yaml` and
+//! URDF models against Pinocchio: `tests/robots/ur5.yaml`,
 //! `tests/robots/panda.yaml` (URDFs from example-robot-data, shipped in
-//! `tests/robots/urdf/`) compiled by `model!`, compared with the values that
+//! `tests/robots/urdf/`) and `tests/robots/slider_arm.yaml` (a URDF written
+//! for the tests) compiled by `model!`, compared with the values that
 //! `tests/pinocchio_reference.py` wrote with Pinocchio at 8 seeded
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
 //! matrix (Pinocchio's CRBA), `F = C v + G` (its nonlinear effects), `G`,
@@ -16,6 +17,7 @@ use serde_json::Value;
 
 moreau::model!(file = "tests/robots/ur5.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
+moreau::model!(file = "tests/robots/slider_arm.yaml");
 
 const RTOL: f64 = 1e-10;
 
@@ -154,6 +156,18 @@ fn panda_matches_pinocchio() {
             "panda_joint6",
             "panda_joint7",
         ],
+    );
+}
+
+/// A URDF written for the tests: prismatic joints (one on a skewed axis),
+/// a continuous joint, joint frames and inertias turned by roll-pitch-yaw,
+/// a branch.
+#[test]
+fn slider_arm_matches_pinocchio() {
+    compare(
+        &SliderArm::<f64>::new(),
+        "slider_arm",
+        ["slide", "shoulder", "elbow", "side_slide"],
     );
 }
 

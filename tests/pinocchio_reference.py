@@ -2,9 +2,11 @@
 """Pinocchio reference values for the URDF models of moreau (issue 11).
 
 For each robot below, the URDF shipped in ``tests/robots/urdf/`` (copied
-from the ``example-robot-data`` wheel, whose copy must be byte-identical) is
+from the ``example-robot-data`` wheel, whose copy must be byte-identical, or
+written for these tests: ``synthetic/``) is
 loaded with Pinocchio (fixed base; the ``locked`` joints held at zero with
-``buildReducedModel``), and at seeded configurations the script writes:
+``buildReducedModel``), and at seeded configurations (one coordinate per joint, the angle of a
+continuous joint too) the script writes:
 
 - ``M``: the mass matrix (CRBA, both triangles);
 - ``nle``: the nonlinear effects ``C(q, v) v + G(q)`` (RNEA with zero
@@ -63,18 +65,37 @@ ROBOTS = [
         ["panda_finger_joint1", "panda_finger_joint2"],
         [("panda_hand", [0.0, 0.0, 0.1]), ("panda_link4", [0.03, 0.0, -0.02])],
     ),
+    (
+        "slider_arm",
+        "tests/robots/urdf/synthetic/slider_arm.urdf",
+        None,
+        [],
+        [("tool", [0.02, 0.01, 0.05]), ("side", [0.0, 0.1, -0.03])],
+    ),
 ]
 
 
-def wheel_copy_matches(repo_path: Path, wheel_rel: str) -> bool:
-    """Whether the repository's copy is the wheel's file, byte for byte."""
+def wheel_copy_matches(repo_path: Path, wheel_rel) -> bool:
+    """Whether the repository's copy is the wheel's file, byte for byte
+    (``wheel_rel`` is None for a URDF written for these tests)."""
     from importlib.metadata import distribution
 
+    if wheel_rel is None:
+        return True
     wanted = "robots/" + wheel_rel
     for f in distribution("example-robot-data").files or []:
         if str(f).endswith(wanted):
             return Path(f.locate()).read_bytes() == repo_path.read_bytes()
     raise SystemExit(f"example-robot-data has no {wanted}")
+
+
+def configuration(model, angles):
+    """Pinocchio's configuration vector for one coordinate per joint: a
+    continuous joint (nq = 2) is stored as (cos θ, sin θ)."""
+    q = []
+    for j, x in zip(model.joints[1:], angles):
+        q.extend([math.cos(x), math.sin(x)] if j.nq == 2 else [x])
+    return np.array(q)
 
 
 def skew(r):
@@ -89,18 +110,19 @@ def reference(name, urdf, wheel_rel, locked, points):
     ids = [full.getJointId(j) for j in locked]
     model = pin.buildReducedModel(full, ids, pin.neutral(full)) if ids else full
     data = model.createData()
-    assert model.nq == model.nv, "a fixed base of 1-dof joints"
+    assert all(j.nv == 1 for j in model.joints[1:]), "a fixed base of 1-dof joints"
     joints = [model.names[i] for i in range(1, model.njoints)]
     rng = np.random.default_rng(11)
     samples = []
     for _ in range(SAMPLES):
-        q = rng.uniform(-math.pi, math.pi, model.nq)
+        q = rng.uniform(-math.pi, math.pi, model.nv)
         v = rng.uniform(-2.0, 2.0, model.nv)
-        M = pin.crba(model, data, q)
+        q_pin = configuration(model, q)
+        M = pin.crba(model, data, q_pin)
         M = np.triu(M) + np.triu(M, 1).T
-        nle = pin.nonLinearEffects(model, data, q, v)
-        G = pin.computeGeneralizedGravity(model, data, q)
-        pin.computeJointJacobians(model, data, q)
+        nle = pin.nonLinearEffects(model, data, q_pin, v)
+        G = pin.computeGeneralizedGravity(model, data, q_pin)
+        pin.computeJointJacobians(model, data, q_pin)
         pin.updateFramePlacements(model, data)
         out = []
         for link, r in points:
