@@ -25,6 +25,8 @@ pub(crate) const BODIES: &str = "bodies";
 pub(crate) const URDF: &str = "urdf";
 /// The URDF's joints to hold at zero (made fixed).
 pub(crate) const LOCKED: &str = "locked";
+/// The URDF's joints whose `<limit>`s become constraints.
+pub(crate) const LIMITS: &str = "limits";
 /// The gravity vector of the tree (default `[0, 0, -9.81]`).
 pub(crate) const GRAVITY: &str = "gravity";
 /// Keys of one body (YAML).
@@ -49,7 +51,7 @@ pub(crate) const WORLD: &str = "world";
 pub(crate) const H: &str = "h";
 
 /// Every top-level YAML key, in the order the documentation lists them.
-pub(crate) const TOP_LEVEL: [&str; 16] = [
+pub(crate) const TOP_LEVEL: [&str; 17] = [
     NAME,
     DOC,
     COORDINATES,
@@ -58,6 +60,7 @@ pub(crate) const TOP_LEVEL: [&str; 16] = [
     DEFINITIONS,
     URDF,
     LOCKED,
+    LIMITS,
     BODIES,
     GRAVITY,
     KINETIC,

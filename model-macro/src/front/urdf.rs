@@ -14,6 +14,8 @@
 //! - the link's `<inertial>`: `mass`, `origin xyz` as the centre of mass and
 //!   the inertia rotated by `origin rpy` into the link's frame
 //!   (`R I Rᵀ`), computed here in `f64`;
+//! - joints listed in the model's `limits` get the constraints
+//!   `q − lower ≥ 0` and `upper − q ≥ 0` from their `<limit>`;
 //! - joints listed in the model's `locked` are held at zero: they become
 //!   fixed joints (Pinocchio's `buildReducedModel` at the zero
 //!   configuration).
@@ -37,6 +39,8 @@ struct UrdfJoint<'a> {
     xyz: [f64; 3],
     rpy: [f64; 3],
     axis: [f64; 3],
+    /// `lower` and `upper` of `<limit>`, when both are given.
+    limit: Option<(f64, f64)>,
 }
 
 #[derive(Default, Clone, Copy)]
@@ -53,6 +57,15 @@ struct Inertial {
 pub(crate) struct Imported {
     pub bodies: Vec<Body>,
     pub coordinates: Vec<Coordinate>,
+    /// The `<limit lower upper>` of every moving joint that has both.
+    pub limits: Vec<Limit>,
+}
+
+/// A joint's position limits, as the URDF gives them.
+pub(crate) struct Limit {
+    pub joint: String,
+    pub lower: f64,
+    pub upper: f64,
 }
 
 /// Reads the URDF `text` (shown in messages as `display`). Every problem is
@@ -150,6 +163,7 @@ pub(crate) fn import(
     let mut imported = Imported {
         bodies: Vec::new(),
         coordinates: Vec::new(),
+        limits: Vec::new(),
     };
     let mut stack: Vec<(usize, Option<&str>)> = joints
         .iter()
@@ -169,6 +183,13 @@ pub(crate) fn import(
     };
     while let Some((i, parent)) = stack.pop() {
         let j = &joints[i];
+        if let (Some((lower, upper)), true) = (j.limit, j.kind != JointKind::Fixed) {
+            imported.limits.push(Limit {
+                joint: j.name.to_string(),
+                lower,
+                upper,
+            });
+        }
         let coordinate = (j.kind != JointKind::Fixed).then(|| {
             imported.coordinates.push(Coordinate {
                 q: name(j.name),
@@ -337,6 +358,15 @@ fn joint<'a>(
     let xyz = numbers(origin, "xyz", [0.0; 3], at, errors);
     let rpy = numbers(origin, "rpy", [0.0; 3], at, errors);
     let axis = numbers(child(node, "axis"), "xyz", [1.0, 0.0, 0.0], at, errors);
+    let limit_node = child(node, "limit");
+    let limit = match limit_node.map(|l| (l.attribute("lower"), l.attribute("upper"))) {
+        Some((Some(_), Some(_))) => {
+            let [lower] = numbers(limit_node, "lower", [0.0], at, errors);
+            let [upper] = numbers(limit_node, "upper", [0.0], at, errors);
+            Some((lower, upper))
+        }
+        _ => None,
+    };
     let (name, kind) = (name?, kind?);
     let is_locked = locked.iter().any(|l| l.text == name);
     let kind = match kind {
@@ -380,5 +410,6 @@ fn joint<'a>(
         xyz,
         rpy,
         axis,
+        limit,
     })
 }

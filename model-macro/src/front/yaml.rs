@@ -150,6 +150,7 @@ pub(crate) fn build(
     };
     let mut seen: Vec<&str> = Vec::new();
     let (mut urdf, mut locked): (Option<(Name, &YNode)>, Vec<Name>) = (None, Vec::new());
+    let mut limits: Vec<Name> = Vec::new();
     for (key, value) in entries {
         let Some(k) = w.key(key) else { continue };
         if let Some(first) = seen.iter().find(|s| **s == k.text) {
@@ -164,17 +165,24 @@ pub(crate) fn build(
                 }
                 seen.push(keys::URDF);
             }
-            keys::LOCKED => {
-                match &value.kind {
-                    YKind::Seq(items) => {
-                        locked = items
-                            .iter()
-                            .filter_map(|i| w.name(i, "a locked joint"))
-                            .collect();
+            keys::LOCKED | keys::LIMITS => {
+                let names = match &value.kind {
+                    YKind::Seq(items) => items
+                        .iter()
+                        .filter_map(|i| w.name(i, "a joint of the URDF"))
+                        .collect(),
+                    _ => {
+                        w.expected(value, "a list of joint names, like `[joint1, joint2]`");
+                        Vec::new()
                     }
-                    _ => w.expected(value, "a list of joint names, like `[finger1, finger2]`"),
+                };
+                if k.text == keys::LOCKED {
+                    locked = names;
+                    seen.push(keys::LOCKED);
+                } else {
+                    limits = names;
+                    seen.push(keys::LIMITS);
                 }
-                seen.push(keys::LOCKED);
             }
             _ => {
                 if let Some(known) = w.top_level(&mut spec, &k, value) {
@@ -184,11 +192,11 @@ pub(crate) fn build(
         }
     }
     if let Some((urdf, node)) = urdf {
-        w.import_urdf(&mut spec, &urdf, node, &locked);
-    } else if let Some(first) = locked.first() {
+        w.import_urdf(&mut spec, &urdf, node, &locked, &limits);
+    } else if let Some(first) = locked.first().or(limits.first()) {
         cx.error(
             first.loc,
-            "`locked` names joints of a URDF, but this model has no `urdf`",
+            "`locked` and `limits` name joints of a URDF, but this model has no `urdf`",
         );
     }
     let has_bodies = seen.contains(&keys::BODIES) || seen.contains(&keys::URDF);
@@ -217,7 +225,14 @@ impl Walker<'_> {
     /// Reads the URDF named by `urdf:` and appends its bodies and joint
     /// coordinates to `spec`; its problems are reported at the `urdf:`
     /// value, each message starting with the URDF's `path:line:column`.
-    fn import_urdf(&self, spec: &mut ModelSpec, path: &Name, node: &YNode, locked: &[Name]) {
+    fn import_urdf(
+        &self,
+        spec: &mut ModelSpec,
+        path: &Name,
+        node: &YNode,
+        locked: &[Name],
+        limits: &[Name],
+    ) {
         let loc = self.loc(node);
         let (source, absolute) = match read_file(&path.text, self.span, "URDF file") {
             Ok(read) => read,
@@ -240,6 +255,7 @@ impl Walker<'_> {
                     spec.bodies.push(b);
                 }
                 spec.bodies_loc.get_or_insert(loc);
+                self.limit_constraints(spec, &imported.limits, limits, &source.display);
             }
             Err(messages) => {
                 for m in messages {
@@ -466,6 +482,58 @@ impl Walker<'_> {
                 }
             })
             .collect()
+    }
+
+    /// The constraints `q − lower ≥ 0` (`<joint>_lower`) and `upper − q ≥ 0`
+    /// (`<joint>_upper`) of each joint named in `limits:`, from the URDF's
+    /// `<limit>`; they take the model's restitution.
+    fn limit_constraints(
+        &self,
+        spec: &mut ModelSpec,
+        found: &[super::urdf::Limit],
+        wanted: &[Name],
+        display: &str,
+    ) {
+        for name in wanted {
+            let Some(limit) = found.iter().find(|l| l.joint == name.text) else {
+                self.cx.error(
+                    name.loc,
+                    format!(
+                        "`{}` is not a moving joint of {display} with a `<limit lower=… upper=…>`",
+                        name.text
+                    ),
+                );
+                continue;
+            };
+            let loc = name.loc;
+            let node = |kind| Box::new(Expr { kind, loc });
+            let q = || node(crate::expr::ExprKind::Name(name.text.clone()));
+            let x = |v| node(crate::expr::ExprKind::Num(v));
+            use crate::expr::BinOp::Sub;
+            for (suffix, h) in [
+                (
+                    "lower",
+                    crate::expr::ExprKind::Binary(Sub, q(), x(limit.lower)),
+                ),
+                (
+                    "upper",
+                    crate::expr::ExprKind::Binary(Sub, x(limit.upper), q()),
+                ),
+            ] {
+                spec.constraints.push(Constraint {
+                    name: Name {
+                        text: format!("{}_{suffix}", name.text),
+                        loc,
+                    },
+                    h: Expr { kind: h, loc },
+                    restitution: None,
+                    doc: vec![format!(
+                        "The {suffix} limit of joint `{}` (from the URDF).",
+                        name.text
+                    )],
+                });
+            }
+        }
     }
 
     /// `[x, y, z]`: three expressions.

@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/urdf_limits.yaml");
+
+fn main() {}
