@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use crate::expr::fmt_number;
 use crate::keys;
-use crate::spec::{ModelSpec, Origin};
+use crate::spec::{JointKind, ModelSpec, Origin};
 
 /// The model's text in the YAML language.
 pub(crate) fn source(spec: &ModelSpec) -> String {
@@ -30,8 +30,20 @@ fn canonical(spec: &ModelSpec) -> String {
             .replace('"', "\\\"");
         let _ = writeln!(s, "{}: \"{doc}\"", keys::DOC);
     }
-    let _ = writeln!(s, "{}:", keys::COORDINATES);
-    for c in &spec.coordinates {
+    // Joint coordinates are declared by their bodies.
+    let joints: Vec<usize> = spec
+        .bodies
+        .iter()
+        .filter_map(|b| b.joint.coordinate)
+        .collect();
+    let written: Vec<_> = (0..spec.coordinates.len())
+        .filter(|i| !joints.contains(i))
+        .map(|i| &spec.coordinates[i])
+        .collect();
+    if !written.is_empty() || spec.bodies.is_empty() {
+        let _ = writeln!(s, "{}:", keys::COORDINATES);
+    }
+    for c in written {
         let _ = writeln!(s, "  - {}: {}", c.q.text, c.v.text);
     }
     if !spec.parameters.is_empty() {
@@ -49,6 +61,50 @@ fn canonical(spec: &ModelSpec) -> String {
         for d in &spec.definitions {
             let _ = writeln!(s, "  {}: \"{}\"", d.name.text, d.expr);
         }
+    }
+    if let Some(g) = &spec.gravity {
+        let _ = writeln!(s, "{}: {}", keys::GRAVITY, list(g));
+    }
+    if !spec.bodies.is_empty() {
+        let _ = writeln!(s, "{}:", keys::BODIES);
+    }
+    for b in &spec.bodies {
+        let j = &b.joint;
+        let _ = writeln!(s, "  - {}: {}", keys::NAME, b.name.text);
+        if let Some(p) = &b.parent {
+            let _ = writeln!(s, "    {}: {}", keys::PARENT, p.text);
+        }
+        let kind = match j.kind {
+            JointKind::Revolute => "revolute",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+        };
+        let _ = write!(s, "    {}: {{{}: {kind}", keys::JOINT, keys::TYPE);
+        if let Some(i) = j.coordinate {
+            let c = &spec.coordinates[i];
+            let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
+            let _ = write!(
+                s,
+                ", {}: {}, {}: {}, {}: [{}]",
+                keys::NAME,
+                c.q.text,
+                keys::VELOCITY,
+                c.v.text,
+                keys::AXIS,
+                axis.join(", ")
+            );
+        }
+        let _ = writeln!(
+            s,
+            ", {}: {}, {}: {}}}",
+            keys::XYZ,
+            list(&j.xyz),
+            keys::RPY,
+            list(&j.rpy)
+        );
+        let _ = writeln!(s, "    {}: \"{}\"", keys::MASS, b.mass);
+        let _ = writeln!(s, "    {}: {}", keys::COM, list(&b.com));
+        let _ = writeln!(s, "    {}: {}", keys::INERTIA, list(&b.inertia));
     }
     if let Some(k) = &spec.kinetic {
         let _ = writeln!(s, "{}: \"{k}\"", keys::KINETIC);
@@ -82,6 +138,12 @@ fn canonical(spec: &ModelSpec) -> String {
         }
     }
     s
+}
+
+/// `["e1", "e2", …]`: expressions as a YAML flow list.
+fn list(items: &[crate::expr::Expr]) -> String {
+    let quoted: Vec<String> = items.iter().map(|e| format!("\"{e}\"")).collect();
+    format!("[{}]", quoted.join(", "))
 }
 
 #[cfg(test)]
@@ -133,5 +195,55 @@ mod tests {
         assert_eq!(again, text);
         assert!(text.contains("h: \"y - (r2 - 1)\""), "{text}");
         assert!(text.contains("h: \"2 - y\""), "{text}");
+    }
+
+    /// An inline model with bodies prints as YAML that reads back as the
+    /// same model (the joint coordinates declared by their bodies, after
+    /// the written ones).
+    #[test]
+    fn bodies_round_trip_through_the_yaml_front_end() {
+        let tokens: proc_macro2::TokenStream = r#"
+            pub struct Arm;
+            bodies {
+                upper: { joint: revolute(a1: w1), axis: [0, -1, 0], xyz: [0, 0, 0.3], mass: m, com: [0, 0, -l / 2], inertia: [1, 0, 0, 1, 0, 2] },
+                tip: { parent: upper, joint: fixed, xyz: [0, 0, -l], rpy: [0.1, 0, 0], mass: 0.25 },
+                slider: { parent: upper, joint: prismatic(s), axis: [1, 0, 0], mass: 1 },
+            }
+            coordinates { x: vx }
+            parameters { m: 1.5, l: 0.9, g: 9.81 }
+            gravity = [0, 0, -g];
+            kinetic = 0.5 * vx^2;
+            constraints { floor: position_z(tip) + 1 >= 0 }
+            restitution = 0.5;
+        "#
+        .parse()
+        .unwrap();
+        let cx = Ctxt::new();
+        let spec = inline::build(&cx, tokens).unwrap();
+        cx.check().unwrap();
+        let names: Vec<&str> = spec.coordinates.iter().map(|c| c.q.text.as_str()).collect();
+        assert_eq!(names, ["x", "a1", "s"]);
+        assert_eq!(spec.coordinates[2].v.text, "ds");
+        let text = super::source(&spec);
+        let source = YamlSource {
+            display: "arm.yaml".into(),
+            text: text.clone(),
+        };
+        let root = source.parse().unwrap();
+        let cx = Ctxt::with_locator(source);
+        let again = yaml::build(
+            &cx,
+            &root,
+            proc_macro2::Span::call_site(),
+            std::path::Path::new("arm.yaml"),
+            text.clone(),
+        )
+        .unwrap();
+        cx.check().unwrap();
+        assert_eq!(super::canonical(&again), text);
+        assert!(
+            text.contains("h: \"position_z(tip, 0, 0, 0) + 1\""),
+            "{text}"
+        );
     }
 }
