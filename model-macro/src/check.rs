@@ -13,7 +13,7 @@ use crate::ctxt::Ctxt;
 use crate::expr::Expr;
 use crate::keys;
 use crate::loc::Loc;
-use crate::resolve::{Scope, Symbol, Var};
+use crate::scope::{Scope, Symbol, Var};
 use crate::spec::{ModelSpec, Name, PRELUDE_VALUES, RESERVED, RUST_KEYWORDS, is_identifier};
 
 /// Runs every check.

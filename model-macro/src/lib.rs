@@ -20,7 +20,7 @@
 //! struct and stub impls (`emit::fallback`) beside the errors. Supporting
 //! modules sit below every stage: `loc` (where things came from), `ctxt`
 //! (the error collector; the YAML front end hands it its locator as a
-//! value), `keys` (the language's vocabulary), `expr` (the grammar and the
+//! value), `scope` (the one name table), `keys` (the language's vocabulary), `expr` (the grammar and the
 //! one parser), `render` (an inline model's text in the YAML language).
 //!
 //! Follow a user name, say the coordinate `th1` of `models/double_pendulum.yaml`:
@@ -48,6 +48,7 @@ mod loc;
 mod lower;
 mod render;
 mod resolve;
+mod scope;
 mod spec;
 
 use proc_macro::TokenStream;
