@@ -18,6 +18,10 @@ mod stepper;
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Sensitivities, Terms};
 pub use observer::{
+    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+};
+pub use observer::{
     Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
     ObserverError, ObserverParams, ReducedOrder, UpdateReport,
 };

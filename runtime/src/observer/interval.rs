@@ -15,6 +15,9 @@ use super::{ObserverError, ObserverParams, UpdateReport, check_restitution, chec
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
+mod traced;
+pub(crate) use traced::{Flight, Jump, Tracer};
+
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
 /// the ball `|v| ≤ C_v`, 1-Lipschitz, so `F̄(t, q, v) = F(t, q, sat(v))` is
 /// the Lipschitz extension of Assumption 1.
