@@ -17,8 +17,8 @@ use super::{Crossing, Interval, Result, Segment, UpdateReport};
 
 /// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
 /// length `h`, with the persistent contacts `sliding` held at acceleration
-/// level, ending at `(p1, w1)`.
-pub(crate) struct Flight<'a, T: RealField + Copy, const N: usize> {
+/// level (`impulse` their `∫ λ ds`), ending at `(p1, w1)`.
+pub(crate) struct Flight<'a, T: RealField + Copy, const N: usize, const K: usize> {
     pub s0: T,
     pub h: T,
     pub p0: &'a SVector<T, N>,
@@ -26,6 +26,7 @@ pub(crate) struct Flight<'a, T: RealField + Copy, const N: usize> {
     pub p1: &'a SVector<T, N>,
     pub w1: &'a SVector<T, N>,
     pub sliding: IndexSet,
+    pub impulse: &'a SVector<T, K>,
 }
 
 /// One application of Newton's law at local time `s`, configuration `p`:
@@ -47,7 +48,7 @@ pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> 
 /// What follows the predicted motion of an interval, piece by piece.
 pub(crate) trait Tracer<T: RealField + Copy, const N: usize, const K: usize> {
     /// A piece of flight (or sliding) was integrated.
-    fn flight(&mut self, piece: &Flight<'_, T, N>) -> Result<(), T>;
+    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T>;
     /// Newton's law was applied.
     fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T>;
 }
@@ -136,6 +137,7 @@ where
                         p1: &part.p,
                         w1: &part.w,
                         sliding: c.sliding,
+                        impulse: &part.impulse,
                     })?;
                     report.impulses += part.impulse;
                     (s, p, w) = (s + at, part.p, part.w);
@@ -151,6 +153,7 @@ where
                 p1: &arc.p,
                 w1: &arc.w,
                 sliding: c.sliding,
+                impulse: &arc.impulse,
             })?;
             report.impulses += arc.impulse;
             return Ok((arc.p, arc.w));

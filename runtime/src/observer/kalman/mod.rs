@@ -468,10 +468,15 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
                 .accel_noise
                 .component_mul(&self.params.accel_noise),
             p: self.p,
+            correction: (SVector::zeros(), SVector::zeros()),
             saltations: 0,
             projections: 0,
         };
         let (q_pred, v_pred) = interval.predict_traced(&self.v, &mut report, &mut propagation)?;
+        let (q_pred, v_pred) = (
+            q_pred + propagation.correction.0,
+            v_pred + propagation.correction.1,
+        );
         let mut p = propagation.p;
         let mut kalman = KalmanReport {
             saltations: propagation.saltations,
@@ -568,6 +573,9 @@ where
     /// `q_a²` per coordinate.
     density: SVector<T, N>,
     p: Blocks<T, N>,
+    /// The move of the predicted end onto the contact manifold, when the
+    /// last piece was a persistent contact.
+    correction: (SVector<T, N>, SVector<T, N>),
     saltations: u32,
     projections: u32,
 }
@@ -594,23 +602,36 @@ where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
-    fn flight(&mut self, piece: &Flight<'_, T, N>) -> Result<(), T> {
+    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
         let w0 = saturate(piece.w0, self.bound);
         let t = self.t0 + piece.s0;
-        let (a, _) = if piece.sliding.is_empty() {
+        // the contacts that pushed along the piece
+        let mut held = IndexSet::EMPTY;
+        for i in piece.sliding.iter().filter(|&i| i < K) {
+            if piece.impulse[i] > T::zero() {
+                held.insert(i);
+            }
+        }
+        let (a, _) = if held.is_empty() {
             flow_jacobian(self.model, t, piece.p0, &w0, self.u)?
         } else {
-            constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, piece.sliding)?
+            constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
         };
         let mut p = transition(&a, piece.h).congruence(&self.p);
-        if !piece.sliding.is_empty() {
-            // onto the manifold h_S = 0, J_S v = 0 at the end of the piece
-            let (_, jac) = self.model.contact(piece.p1);
+        self.correction = (SVector::zeros(), SVector::zeros());
+        if !held.is_empty() {
+            // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
+            // the covariance, and the state by the same gains
+            let (h, jac) = self.model.contact(piece.p1);
             let rate = self.model.jacobian_dq(piece.p1, piece.w1);
+            super::interval::finite(&h, "h")?;
             super::interval::finite(&jac, "J")?;
             super::interval::finite(&rate, "d(Jv)/dq")?;
-            p = condition(&p, &jac, &SMatrix::zeros(), piece.sliding);
-            p = condition(&p, &rate, &jac, piece.sliding);
+            let (p1, dq1, dv1) = condition(&p, &jac, &SMatrix::zeros(), held, &h);
+            let speed = jac * piece.w1 + rate * dq1 + jac * dv1;
+            let (p2, dq2, dv2) = condition(&p1, &rate, &jac, held, &speed);
+            p = p2;
+            self.correction = (dq1 + dq2, dv1 + dv2);
             self.projections += 1;
         }
         self.p = p.add(&process_noise(&self.density, piece.h)).symmetrized();
@@ -649,6 +670,7 @@ where
                 _ => Some((i, r)),
             })
             .map(|(i, _)| i);
+        self.correction = (SVector::zeros(), SVector::zeros());
         let w = saturate(jump.w_minus, self.bound);
         let s = saltation(
             self.model,

@@ -452,12 +452,17 @@ where
 /// with a perfect measurement, `P ← (I − L G) P (I − L G)ᵀ`,
 /// `L = P Gᵀ (G P Gᵀ)⁻¹`). Rows whose variance `(G P Gᵀ)_ii` is below
 /// `√ε` of the terms it is made of are satisfied already and skipped.
+///
+/// The state moves with it: for the residual `r` of the constraints (their
+/// value at the current estimate), the correction `−L r` is returned.
 pub(crate) fn condition<T: RealField + Copy, const N: usize, const K: usize>(
     p: &Blocks<T, N>,
     g_q: &SMatrix<T, K, N>,
     g_v: &SMatrix<T, K, N>,
     set: IndexSet,
-) -> Blocks<T, N> {
+    residual: &SVector<T, K>,
+) -> (Blocks<T, N>, SVector<T, N>, SVector<T, N>) {
+    let unchanged = (*p, SVector::zeros(), SVector::zeros());
     let mut gq = SMatrix::<T, K, N>::zeros();
     let mut gv = SMatrix::<T, K, N>::zeros();
     for i in set.iter().filter(|&i| i < K) {
@@ -488,11 +493,11 @@ pub(crate) fn condition<T: RealField + Copy, const N: usize, const K: usize>(
         }
     }
     if !any {
-        return *p;
+        return unchanged;
     }
     let s = (s + s.transpose()) * nalgebra::convert::<f64, T>(0.5);
     let Some(chol) = Cholesky::new(&s) else {
-        return *p;
+        return unchanged;
     };
     let u_q = p.qq * gq.transpose() + p.qv * gv.transpose();
     let u_v = p.vq * gq.transpose() + p.vv * gv.transpose();
@@ -505,5 +510,16 @@ pub(crate) fn condition<T: RealField + Copy, const N: usize, const K: usize>(
         vq: -(l_v * gq),
         vv: id - l_v * gv,
     };
-    b.congruence(p)
+    let mut r = SVector::<T, K>::zeros();
+    for i in 0..K {
+        if gq
+            .row(i)
+            .iter()
+            .chain(gv.row(i).iter())
+            .any(|x| *x != T::zero())
+        {
+            r[i] = residual[i];
+        }
+    }
+    (b.congruence(p), -(l_q * r), -(l_v * r))
 }

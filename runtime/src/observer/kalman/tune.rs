@@ -6,7 +6,7 @@ use nalgebra::{RealField, SVector};
 use crate::model::Sensitivities;
 
 use super::super::ObserverError;
-use super::{KalmanParams, SaltationKalman};
+use super::{KalmanParams, KalmanReport, SaltationKalman};
 
 /// The outcome of [`tune_process_noise`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,7 +115,15 @@ where
         let mut total = T::zero();
         for (&tk, qk) in t.iter().zip(q).skip(1) {
             filter.update(model, tk, qk, u)?;
-            total += filter.kalman_report().log_likelihood(N);
+            // a sample past the gate counts as at the gate: one impact
+            // the model places a sample off must not set the noise level
+            // of the whole run
+            let r = filter.kalman_report();
+            let capped = KalmanReport {
+                nis: r.nis.min(p.gate),
+                ..*r
+            };
+            total += capped.log_likelihood(N);
         }
         Ok(total)
     };
