@@ -25,15 +25,21 @@
 //!      plastic, the impact time moved by the constraint whose root timed
 //!      it (none for a plastic closure or a law met at a closed constraint:
 //!      then `Ξ = DΔ`, the reset's Jacobian);
-//!    - a piece of persistent contact on the set `S`: the flight's `Φ`,
-//!      then `P` conditioned on the constraint manifold at the end of the
-//!      piece, `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
+//!    - a piece of persistent contact on the set `S` (the constraints whose
+//!      multiplier pushed along it): the Jacobian of the constrained flow
+//!      ([`constrained_flow_jacobian`]), `P ← Φ P Φᵀ + Q(h)`, then `P`
+//!      projected onto the tangent space of the contact manifold at the
+//!      end of the piece, `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
 //!      `J_S δq = 0` and `∂(J_S v)/∂q δq + J_S δv = 0`
-//!      ([`Sensitivities::jacobian_dq`]), in Joseph form; then `Q(h)`. The
-//!      contact force cancels the normal motion the model predicts, not
-//!      the unmodelled acceleration of the last piece: adding `Q` after
-//!      the projection keeps `P` positive definite and lets the samples
-//!      pull the estimate off a contact the model holds wrongly.
+//!      ([`Sensitivities::jacobian_dq`]), in the metric of `M` (that of a
+//!      plastic impact): `P ← B P Bᵀ`, a congruence, so positive
+//!      semi-definite whatever the round-off; the predicted state is moved
+//!      onto the manifold in the same metric. The contact force cancels
+//!      the normal motion, modelled and unmodelled; what stays uncertain
+//!      across the contact (its compliance, the plant's own penetration)
+//!      is the noise's position and velocity variances, added
+//!      uncorrelated: `P` stays positive definite, and a penetration seen
+//!      in exact samples moves the position estimate, not the velocity.
 //! 2. **Gate** the innovation `y = q_{k+1} − p(τ)`, `S = P_qq + R`: a
 //!    normalised innovation squared `yᵀS⁻¹y` above
 //!    [`KalmanParams::gate`] marks the sample an outlier; it is reported
@@ -45,7 +51,7 @@
 //!    Joseph form `P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ`, symmetrised.
 //!
 //! Nothing here is written by the user: the Jacobians come from the
-//! model's generated [`Model::linearization`] and [`Sensitivities`].
+//! model's generated [`Model::linearization`](crate::Model::linearization) and [`Sensitivities`].
 
 mod blocks;
 mod saltation;
@@ -60,11 +66,11 @@ use nalgebra::{RealField, SMatrix, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Sensitivities;
 
-use super::interval::{Flight, Interval, Jump, Memory, Tracer, saturate};
+use super::interval::{Flight, Interval, Jump, Memory, Tracer, factor_mass, saturate};
 use super::{
     Estimate, ObserverError, ObserverParams, UpdateReport, check_restitution, check_vector,
 };
-use saltation::condition;
+use saltation::project_onto_contact;
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
@@ -238,7 +244,7 @@ impl<T: RealField + Copy> KalmanReport<T> {
 ///
 /// Its methods mirror [`Observer`](super::Observer)'s (`update`,
 /// `estimate`, `report`, `params`); it cannot implement that trait, whose
-/// `update` accepts any [`Model`], because the covariance needs the
+/// `update` accepts any [`Model`](crate::Model), because the covariance needs the
 /// model's [`Sensitivities`] (every `model!` type has them).
 ///
 /// ```
@@ -617,24 +623,35 @@ where
         } else {
             constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
         };
+        let noise = process_noise(&self.density, piece.h);
         let mut p = transition(&a, piece.h).congruence(&self.p);
         self.correction = (SVector::zeros(), SVector::zeros());
-        if !held.is_empty() {
+        if held.is_empty() {
+            p = p.add(&noise);
+        } else {
+            p = p.add(&noise);
             // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
-            // the covariance, and the state by the same gains
+            // the covariance, and the state in the same metric
             let (h, jac) = self.model.contact(piece.p1);
             let rate = self.model.jacobian_dq(piece.p1, piece.w1);
             super::interval::finite(&h, "h")?;
             super::interval::finite(&jac, "J")?;
             super::interval::finite(&rate, "d(Jv)/dq")?;
-            let (p1, dq1, dv1) = condition(&p, &jac, &SMatrix::zeros(), held, &h);
-            let speed = jac * piece.w1 + rate * dq1 + jac * dv1;
-            let (p2, dq2, dv2) = condition(&p1, &rate, &jac, held, &speed);
-            p = p2;
-            self.correction = (dq1 + dq2, dv1 + dv2);
-            self.projections += 1;
+            let mass = factor_mass(&self.model.mass(piece.p1))?;
+            if let Some((projected, dq, dv)) =
+                project_onto_contact(&p, &mass, &h, &jac, &rate, piece.w1, held)
+            {
+                p = projected;
+                self.correction = (dq, dv);
+                self.projections += 1;
+            }
+            // what the contact leaves uncertain across it: the noise's
+            // position and velocity variances, uncorrelated (a correlated
+            // floor would turn the contact's own penetration, seen in the
+            // samples, into a velocity)
+            p = p.add(&Blocks::diagonal(noise.qq, noise.vv));
         }
-        self.p = p.add(&process_noise(&self.density, piece.h)).symmetrized();
+        self.p = p.symmetrized();
         Ok(())
     }
 

@@ -2,7 +2,7 @@
 //! Jacobian of the free dynamics, its transition over a piece of flight,
 //! the saltation matrix of Newton's impact law, and the projection onto
 //! the manifold of a persistent contact. All from the model's generated
-//! derivatives ([`Model::linearization`], [`Sensitivities`]); nothing is
+//! derivatives ([`Model::linearization`](crate::Model::linearization), [`Sensitivities`]); nothing is
 //! differentiated numerically.
 
 use nalgebra::{RealField, SMatrix, SVector};
@@ -447,79 +447,58 @@ where
     })
 }
 
-/// Conditions the covariance `p` on the exact linear constraints
-/// `G_q δq + G_v δv = 0` of the rows in `set` (Joseph form of the update
-/// with a perfect measurement, `P ← (I − L G) P (I − L G)ᵀ`,
-/// `L = P Gᵀ (G P Gᵀ)⁻¹`). Rows whose variance `(G P Gᵀ)_ii` is below
-/// `√ε` of the terms it is made of are satisfied already and skipped.
+/// Projects the state's perturbations onto the tangent space of the
+/// contact manifold `h_S(q) = 0`, `J_S(q) v = 0` at `(q, v)`, in the metric
+/// of the mass matrix (the metric of Newton's law: a plastic impact
+/// projects the velocity the same way). With `J⁺ = M⁻¹ J_Sᵀ (J_S M⁻¹
+/// J_Sᵀ)⁻¹`, `Π = I − J⁺ J_S` and `D = ∂(J_S v)/∂q`:
 ///
-/// The state moves with it: for the residual `r` of the constraints (their
-/// value at the current estimate), the correction `−L r` is returned.
-pub(crate) fn condition<T: RealField + Copy, const N: usize, const K: usize>(
+/// $$B = \begin{pmatrix} \Pi & 0 \\ -J^{+} D\, \Pi & \Pi \end{pmatrix},$$
+///
+/// a projector (`B² = B`) whose range satisfies `J_S δq = 0` and
+/// `D δq + J_S δv = 0`; `P ← B P Bᵀ` (a congruence: positive
+/// semi-definite whatever the round-off of `P`). The state moves onto the
+/// manifold along the same metric: `δq = −J⁺ h_S`, then
+/// `δv = −J⁺ (J_S v + D δq)`. Returns `(B P Bᵀ, δq, δv)`, or `None` when
+/// the rows of `set` are dependent.
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K: usize>(
     p: &Blocks<T, N>,
-    g_q: &SMatrix<T, K, N>,
-    g_v: &SMatrix<T, K, N>,
+    mass: &Cholesky<T, N>,
+    h: &SVector<T, K>,
+    jac: &SMatrix<T, K, N>,
+    rate: &SMatrix<T, K, N>,
+    v: &SVector<T, N>,
     set: IndexSet,
-    residual: &SVector<T, K>,
-) -> (Blocks<T, N>, SVector<T, N>, SVector<T, N>) {
-    let unchanged = (*p, SVector::zeros(), SVector::zeros());
-    let mut gq = SMatrix::<T, K, N>::zeros();
-    let mut gv = SMatrix::<T, K, N>::zeros();
+) -> Option<(Blocks<T, N>, SVector<T, N>, SVector<T, N>)> {
+    let mut j = SMatrix::<T, K, N>::zeros();
+    let mut d = SMatrix::<T, K, N>::zeros();
+    let mut w = SMatrix::<T, K, K>::identity();
+    let mut r_h = SVector::<T, K>::zeros();
     for i in set.iter().filter(|&i| i < K) {
-        gq.set_row(i, &g_q.row(i));
-        gv.set_row(i, &g_v.row(i));
+        j.set_row(i, &jac.row(i));
+        d.set_row(i, &rate.row(i));
+        r_h[i] = h[i];
     }
-    let u_q = p.qq * gq.transpose() + p.qv * gv.transpose();
-    let u_v = p.vq * gq.transpose() + p.vv * gv.transpose();
-    let mut s = gq * u_q + gv * u_v;
-    // a row whose variance is at round-off of the terms it is made of is
-    // satisfied already: decoupled (projecting on it would divide noise
-    // by noise)
-    let (pq, pv) = (p.qq.diagonal().amax(), p.vv.diagonal().amax());
-    let tol = T::default_epsilon().sqrt();
-    let mut any = false;
-    for i in 0..K {
-        let scale = gq.row(i).norm_squared() * pq + gv.row(i).norm_squared() * pv;
-        if !(set.contains(i) && s[(i, i)] > tol * scale && s[(i, i)].is_finite()) {
-            for j in 0..K {
-                s[(i, j)] = T::zero();
-                s[(j, i)] = T::zero();
-            }
-            s[(i, i)] = T::one();
-            gq.row_mut(i).fill(T::zero());
-            gv.row_mut(i).fill(T::zero());
-        } else {
-            any = true;
+    let minv_jt = mass.solve(&j.transpose());
+    let jmj = j * minv_jt;
+    for a in set.iter().filter(|&i| i < K) {
+        for b in set.iter().filter(|&i| i < K) {
+            w[(a, b)] = jmj[(a, b)];
         }
     }
-    if !any {
-        return unchanged;
-    }
-    let s = (s + s.transpose()) * nalgebra::convert::<f64, T>(0.5);
-    let Some(chol) = Cholesky::new(&s) else {
-        return unchanged;
-    };
-    let u_q = p.qq * gq.transpose() + p.qv * gv.transpose();
-    let u_v = p.vq * gq.transpose() + p.vv * gv.transpose();
-    let l_q = chol.solve(&u_q.transpose()).transpose();
-    let l_v = chol.solve(&u_v.transpose()).transpose();
-    let id = SMatrix::<T, N, N>::identity();
+    let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
+    let w_chol = Cholesky::new(&w)?;
+    // J⁺ = M⁻¹Jᵀ W⁻¹ (N × K)
+    let pinv = w_chol.solve(&minv_jt.transpose()).transpose();
+    let pi = SMatrix::<T, N, N>::identity() - pinv * j;
     let b = Blocks {
-        qq: id - l_q * gq,
-        qv: -(l_q * gv),
-        vq: -(l_v * gq),
-        vv: id - l_v * gv,
+        qq: pi,
+        qv: SMatrix::zeros(),
+        vq: -(pinv * d * pi),
+        vv: pi,
     };
-    let mut r = SVector::<T, K>::zeros();
-    for i in 0..K {
-        if gq
-            .row(i)
-            .iter()
-            .chain(gv.row(i).iter())
-            .any(|x| *x != T::zero())
-        {
-            r[i] = residual[i];
-        }
-    }
-    (b.congruence(p), -(l_q * r), -(l_v * r))
+    let dq = -(pinv * r_h);
+    let dv = -(pinv * (j * v + d * dq));
+    Some((b.congruence(p), dq, dv))
 }
