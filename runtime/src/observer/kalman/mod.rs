@@ -9,7 +9,11 @@
 //!    model, every impact located inside the interval (Newton's law with
 //!    the LCP on the closed constraints), persistent contacts held at
 //!    acceleration level, under the same contact rule (module docs of
-//!    `runtime/src/observer/mod.rs`). The interval tells each piece of
+//!    `runtime/src/observer/mod.rs`), whose noise band is the estimate's
+//!    own position uncertainty `√max P_qq,ii` (at most `σ`) and whose
+//!    velocity noise is `√max P_vv,ii`: the prediction starts from the
+//!    filtered `q̂_k`, not from a raw sample, so a bounce a few `σ` high
+//!    is told from sliding. The interval tells each piece of
 //!    motion and each impact as it happens, and the covariance follows:
 //!    - a piece of flight of length `h` from `x_0`:
 //!      `P ← Φ P Φᵀ + Q(h)`, `Φ` the [`transition`] of the Jacobian
@@ -444,8 +448,16 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     where
         M: Sensitivities<N, K, Scalar = T>,
     {
+        // the contact rule's band and velocity noise are those of the
+        // estimate the prediction starts from, not of a raw sample
+        let sigma_q = self.p.qq.diagonal().amax().max(T::zero()).sqrt();
+        let sigma_v = self.p.vv.diagonal().amax().max(T::zero()).sqrt();
+        let rule = ObserverParams {
+            noise: sigma_q.min(self.params.observer.noise),
+            ..self.params.observer
+        };
         let memory = Memory {
-            params: &self.params.observer,
+            params: &rule,
             lcp: &self.lcp,
             t: self.t,
             q: self.q,
@@ -453,15 +465,13 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             report: &self.report,
         };
         let (mut interval, mut report) = Interval::begin(model, u, memory, t, q)?;
-        // the contact rule's velocity noise: the estimate's own
-        let sigma_v = self.p.vv.diagonal().amax().max(T::zero()).sqrt();
-        let sigma = self.params.observer.noise;
+        let sigma = rule.noise;
         interval.gain = if sigma > T::zero() {
             sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
         } else {
             T::zero()
         };
-        interval.uncertainty = self.params.observer.noise_sigmas * sigma_v;
+        interval.uncertainty = rule.noise_sigmas * sigma_v;
         report.gain = interval.gain;
         // PREDICT, the covariance following every piece and impact
         let mut propagation = Propagation {
