@@ -150,6 +150,13 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
 
     /// The same settings with the acceleration noise `q_a` on every
     /// coordinate.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanParams;
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_accel_noise(0.5).scaled(2.0);
+    /// assert_eq!(p.accel_noise[1], 1.0);
+    /// ```
     #[must_use]
     pub fn with_accel_noise(self, q_a: T) -> Self {
         Self {
@@ -233,7 +240,16 @@ impl<T: RealField + Copy> KalmanReport<T> {
     }
 
     /// The log-likelihood of the sample given the past ones,
-    /// `−½ (yᵀS⁻¹y + ln det S + N ln 2π)`.
+    /// `−½ (yᵀS⁻¹y + ln det S + N ln 2π)`, for `N` coordinates.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanReport;
+    ///
+    /// let r = KalmanReport { nis: 0.0, log_det: 0.0, outlier: false, inflated: false,
+    ///                        saltations: 0, projections: 0 };
+    /// let expected = -0.5 * (2.0 * std::f64::consts::PI).ln();
+    /// assert!((r.log_likelihood(1) - expected).abs() < 1e-15);
+    /// ```
     pub fn log_likelihood(&self, n: usize) -> T {
         let two_pi: T = nalgebra::convert(2.0 * core::f64::consts::PI);
         let n: T = nalgebra::convert(n as f64);
