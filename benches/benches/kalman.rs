@@ -8,8 +8,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use moreau::{
-    KalmanParams, MoreauJean, Observer, ObserverParams, ReducedOrder, SaltationKalman,
-    State, StepParams,
+    KalmanParams, MoreauJean, Observer, ObserverParams, ReducedOrder, SaltationKalman, State,
+    StepParams,
 };
 use moreau_models::Parabola;
 use nalgebra::{SVector, Vector2};
@@ -53,7 +53,11 @@ fn updates(c: &mut Criterion) {
     let impact = (100..data.len()).find(|&k| data[k].2 > 0).unwrap();
     let sliding = 6000;
     let mut group = c.benchmark_group("kalman/parabola");
-    for (label, k) in [("free flight", free), ("impact", impact), ("sliding", sliding)] {
+    for (label, k) in [
+        ("free flight", free),
+        ("impact", impact),
+        ("sliding", sliding),
+    ] {
         let kalman_params = KalmanParams::new(20.0, 1e-4);
         let mut kalman =
             SaltationKalman::<f64, 2, 2>::new(kalman_params, 0.0, data[0].1, Vector2::zeros())
