@@ -374,7 +374,7 @@ fn saltation_error<M, const N: usize, const K: usize>(
     guard: usize,
     set: IndexSet,
     e: SVector<f64, K>,
-) -> f64
+) -> (f64, usize)
 where
     M: Sensitivities<N, K, Scalar = f64>,
 {
@@ -385,6 +385,11 @@ where
     let (x_minus, t_hit) = flow_to_guard::<M, N, K>(model, u, &x0, guard);
     let (q_hit, v_hit) = unstack::<N>(&x_minus);
     let (_, lambda) = newton_reset::<M, N, K>(model, &q_hit, &v_hit, set, &e);
+    assert!(
+        lambda.iter().any(|&l| l > 0.0),
+        "{}: no impulse, no impact",
+        M::INFO.name
+    );
     let active =
         IndexSet::from_indices(&(0..K).filter(|&i| lambda[i] > 0.0).collect::<Vec<_>>()).unwrap();
     let salt = saltation(model, 0.0, &q_hit, &v_hit, u, active, &e, Some(guard)).unwrap();
@@ -399,7 +404,22 @@ where
         &x_plus,
     );
     let predicted = &after * dense(&salt.matrix) * &before;
-    (&total - &predicted).abs().max() / total.abs().max()
+    let error = (&total - &predicted).abs().max() / total.abs().max();
+    // the check can fail: the reset's Jacobian alone, without the moving
+    // impact time, is far off
+    let reset = Blocks {
+        qq: SMatrix::identity(),
+        qv: SMatrix::zeros(),
+        vq: salt.reset_dq,
+        vv: salt.reset_dv,
+    };
+    let without_time = (&total - &after * dense(&reset) * &before).abs().max() / total.abs().max();
+    assert!(
+        without_time > 1e-2,
+        "{} without the time term: {without_time:e}",
+        M::INFO.name
+    );
+    (error, active.len())
 }
 
 /// Every shipped model, every kind of impact it has: a single constraint
@@ -411,8 +431,11 @@ where
 #[test]
 fn saltation_matrices_match_finite_differences_of_flow_impact_flow() {
     let mut worst: f64 = 0.0;
-    let mut check = |name: &str, err: f64| {
-        eprintln!("saltation {name}: relative error {err:.2e}");
+    let mut check = |name: &str, (err, active): (f64, usize)| {
+        eprintln!("saltation {name}: {active} active, relative error {err:.2e}");
+        // the balls' impact ends with both contacts active; every other
+        // case with its one constraint
+        assert_eq!(active, if name.contains("pair") { 2 } else { 1 }, "{name}");
         assert!(err < 1e-5, "{name}: {err:e}");
         worst = worst.max(err);
     };
@@ -436,7 +459,7 @@ fn saltation_matrices_match_finite_differences_of_flow_impact_flow() {
             &p,
             &u0,
             Vector2::new(-0.5, 0.25),
-            Vector2::new(2.0, -1.5),
+            Vector2::new(-2.0, -1.5),
             0,
             IndexSet::from_indices(&[0]).unwrap(),
             Vector2::new(0.0, 0.0),
@@ -788,6 +811,10 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 so.all.median,
                 so.all.p90,
                 so.all.max
+            );
+            eprintln!(
+                "  samples after each plant impact past 2 s until |v − v̂| < 1e-2: {:?}",
+                sc.recover
             );
             if sigma == 0.0 {
                 assert!(sc.all.median <= 1e-8, "start {n}: {:e}", sc.all.median);
