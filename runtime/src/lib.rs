@@ -26,6 +26,10 @@ pub use error::DataError;
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Sensitivities, Structure, Terms};
 pub use observer::{
+    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+};
+pub use observer::{
     Design, Discretization, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
     ObserverError, ObserverParams, ReducedOrder, Restart, UpdateReport,
 };

@@ -16,6 +16,9 @@ use crate::validate::{self, factor_mass, finite_model as finite};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
+mod traced;
+pub(crate) use traced::{Flight, Jump, Tracer};
+
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
 /// the ball `|v| ≤ C_v`, 1-Lipschitz, so `F̄(t, q, v) = F(t, q, sat(v))` is
 /// the Lipschitz extension of Assumption 1.
@@ -612,80 +615,7 @@ where
         v0: &SVector<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, N>), T> {
-        let max_impacts = self.params.max_impacts;
-        let max_rounds = max_impacts.saturating_mul(2).saturating_add(8);
-        let (mut s, mut p, mut w) = (T::zero(), self.q0, *v0);
-        // constraints that met Newton's law at this point (no second law
-        // here), and reached by a root at this point (closed whatever the
-        // sign of their gap)
-        let mut resolved = IndexSet::EMPTY;
-        let mut touched = IndexSet::EMPTY;
-        let mut round = 0;
-        loop {
-            round += 1;
-            let last_round = round >= max_rounds;
-            // CLASSIFY at (s, p, w)
-            let free = self.free(s, &p, &w, report)?;
-            let (h, jac) = self.contact(&p)?;
-            let point = Point {
-                s,
-                p: &p,
-                w: &w,
-                free: &free,
-            };
-            let c = self.classify(&point, (&h, &jac), resolved, touched)?;
-            // IMPACT now, on the closed constraints met approaching
-            if !c.approaching.is_empty() && !last_round {
-                let elastic = if report.impacts < max_impacts {
-                    c.elastic
-                } else {
-                    IndexSet::EMPTY
-                };
-                let at = Contact {
-                    s,
-                    w: &w,
-                    jac: &jac,
-                    chol: &free.chol,
-                };
-                w = self.newton(&at, c.contact, elastic, report)?;
-                resolved = resolved.union(c.approaching);
-                touched = touched.union(c.approaching);
-                continue;
-            }
-            // FLIGHT (and sliding) to the end of the interval
-            let rest = self.tau - s;
-            if rest <= T::zero() {
-                return Ok((p, w));
-            }
-            let arc = self.rk4(&point, rest, c.sliding, report)?;
-            report.contacts = report.contacts.union(c.sliding);
-            // SEARCH for the first closing constraint along it
-            if !last_round && report.impacts < max_impacts {
-                let (h1, jac1) = self.contact(&arc.p)?;
-                let seg = Segment {
-                    p0: p,
-                    w0: w,
-                    p1: arc.p,
-                    w1: arc.w,
-                    h: rest,
-                };
-                let rate0 = jac * w;
-                let rate1 = jac1 * arc.w;
-                let band = self.params.contact_band();
-                let bands = SVector::<T, K>::from_fn(|i, _| jac.row(i).norm() * band);
-                if let Some(Crossing { at, set }) =
-                    self.first_crossing(&seg, &c, &bands, (&h, &rate0), (&h1, &rate1))?
-                {
-                    let part = self.rk4(&point, at, c.sliding, report)?;
-                    report.impulses += part.impulse;
-                    (s, p, w) = (s + at, part.p, part.w);
-                    (resolved, touched) = (IndexSet::EMPTY, set);
-                    continue;
-                }
-            }
-            report.impulses += arc.impulse;
-            return Ok((arc.p, arc.w));
-        }
+        self.predict_traced(v0, report, &mut traced::NoTrace)
     }
 
     /// Newton's law at the end of the interval, at the measured `q_{k+1}`,

@@ -282,6 +282,7 @@ mod error;
 mod full_order;
 mod gains;
 mod interval;
+mod kalman;
 mod params;
 mod reduced_order;
 mod report;
@@ -289,6 +290,10 @@ mod report;
 pub use error::ObserverError;
 pub use full_order::{FullOrder, FullOrderGains};
 pub use gains::{Design, GainRegion, ModelBounds};
+pub use kalman::{
+    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+};
 pub use params::{Discretization, ObserverParams};
 pub use reduced_order::ReducedOrder;
 pub use report::{Restart, UpdateReport};
