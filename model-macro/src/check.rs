@@ -172,7 +172,7 @@ fn expressions(spec: &ModelSpec) -> Vec<(String, &Expr)> {
 fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     for (i, d) in spec.definitions.iter().enumerate() {
         d.expr.visit(&mut |name, loc| match scope.get(name) {
-            None => unknown(cx, name, loc),
+            None => unknown(cx, spec, name, loc),
             Some(Symbol::Definition(j)) if j >= i => cx.error(
                 loc,
                 format!("definition `{name}` is used before it is defined (definitions are read in order)"),
@@ -183,13 +183,16 @@ fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     for (_, e) in expressions(spec).into_iter().skip(spec.definitions.len()) {
         e.visit(&mut |name, loc| {
             if scope.get(name).is_none() {
-                unknown(cx, name, loc);
+                unknown(cx, spec, name, loc);
             }
         });
     }
 }
 
-fn unknown(cx: &Ctxt, name: &str, loc: Loc) {
+fn unknown(cx: &Ctxt, spec: &ModelSpec, name: &str, loc: Loc) {
+    if spec.unreadable.iter().any(|n| n.text == name) {
+        return; // its definition's error is reported already
+    }
     cx.error(
         loc,
         format!("unknown name `{name}`: not a coordinate, velocity, parameter, input or definition of this model"),

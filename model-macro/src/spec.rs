@@ -90,6 +90,9 @@ pub(crate) struct ModelSpec {
     pub restitution: Option<Number>,
     pub initial: Vec<(Name, Number)>,
     pub origin: Origin,
+    /// Definitions whose expression could not be read (the front end has
+    /// reported why): their uses are not reported again as unknown names.
+    pub unreadable: Vec<Name>,
 }
 
 /// Names the language reserves: the time and the constant π.

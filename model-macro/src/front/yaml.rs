@@ -137,6 +137,7 @@ pub(crate) fn build(
             path: path.display().to_string(),
             text,
         },
+        unreadable: Vec::new(),
     };
     let mut seen: Vec<&str> = Vec::new();
     for (key, value) in entries {
@@ -211,16 +212,12 @@ impl Walker<'_> {
                 _ => w.expected(value, "a list of input names, like `[u1, u2]`"),
             },
             keys::DEFINITIONS => {
-                spec.definitions = w
-                    .entries(value, keys::DEFINITIONS)
-                    .into_iter()
-                    .filter_map(|(name, v)| {
-                        Some(Definition {
-                            name,
-                            expr: w.expr(v)?,
-                        })
-                    })
-                    .collect();
+                for (name, v) in w.entries(value, keys::DEFINITIONS) {
+                    match w.expr(v) {
+                        Some(expr) => spec.definitions.push(Definition { name, expr }),
+                        None => spec.unreadable.push(name),
+                    }
+                }
             }
             keys::KINETIC => spec.kinetic = w.expr(value),
             keys::POTENTIAL => spec.potential = w.expr(value),
