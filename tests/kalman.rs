@@ -752,12 +752,8 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
     )
     .unwrap();
     eprintln!(
-        "tuned on one run: q_a {:.3e} in flight, {:.3e} in contact, impact η {:.3e}, log-likelihood {:.1}, {} runs",
-        tuned.params.accel_noise[0],
-        tuned.params.contact_noise[0],
-        tuned.params.impact_noise,
-        tuned.log_likelihood,
-        tuned.evaluations
+        "tuned on one run: factor {:.3e}, q_a {:.3e}, log-likelihood {:.1}, {} runs",
+        tuned.factor, tuned.params.accel_noise[0], tuned.log_likelihood, tuned.evaluations
     );
     tuned.params
 }

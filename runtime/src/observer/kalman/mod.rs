@@ -98,23 +98,6 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// timing, unmodelled forces) as a white acceleration of 0.01 m/s² in a
     /// 1 Hz band; [`tune_process_noise`] picks it from a recorded run.
     pub accel_noise: SVector<T, N>,
-    /// Acceleration noise over an interval that holds an impact or a
-    /// persistent contact (sliding, resting), like
-    /// [`accel_noise`](Self::accel_noise) (default the same `1e-2`; it
-    /// adds to the flight's when larger). Kept apart because the model's
-    /// errors differ there: in flight they are the forces' alone, while an
-    /// impact or a contact adds what the impact time and the constraint's
-    /// discretisation leave uncertain (a Moreau–Jean plant penetrates and
-    /// dissipates a little while it slides or accumulates impacts).
-    pub contact_noise: SVector<T, N>,
-    /// Relative uncertainty of a velocity jump: each impact adds
-    /// `η² |Δv|² I` to the velocity covariance, `Δv = v⁺ − v⁻` the jump
-    /// (default `η = 1e-3`): what the impact law leaves uncertain in every
-    /// direction (the restitution, the impact time and point, and so the
-    /// normal the law reflects about; a time-stepping plant places each
-    /// impact within one of its steps, which turns the normal by about
-    /// the curvature times the distance travelled in a step).
-    pub impact_noise: T,
     /// The measurement noise covariance `R` (symmetric positive
     /// semi-definite; default `σ² I` from [`KalmanParams::new`]).
     pub measurement: SMatrix<T, N, N>,
@@ -158,8 +141,6 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
         Self {
             observer: ObserverParams::new(T::one(), velocity_bound).with_noise(sigma),
             accel_noise: SVector::repeat(nalgebra::convert(1e-2)),
-            contact_noise: SVector::repeat(nalgebra::convert(1e-2)),
-            impact_noise: nalgebra::convert(1e-3),
             measurement: SMatrix::identity() * (sigma * sigma),
             gate: chi_square_quantile(N, nalgebra::convert(4.0)),
             max_outliers: 2,
@@ -180,26 +161,6 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     pub fn with_accel_noise(self, q_a: T) -> Self {
         Self {
             accel_noise: SVector::repeat(q_a),
-            contact_noise: SVector::repeat(q_a),
-            ..self
-        }
-    }
-
-    /// The same settings with the acceleration noise `q_c` on every
-    /// coordinate while a contact holds.
-    #[must_use]
-    pub fn with_contact_noise(self, q_c: T) -> Self {
-        Self {
-            contact_noise: SVector::repeat(q_c),
-            ..self
-        }
-    }
-
-    /// The same settings with the relative impact noise `η`.
-    #[must_use]
-    pub fn with_impact_noise(self, eta: T) -> Self {
-        Self {
-            impact_noise: eta,
             ..self
         }
     }
@@ -210,8 +171,6 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     pub fn scaled(self, factor: T) -> Self {
         Self {
             accel_noise: self.accel_noise * factor,
-            contact_noise: self.contact_noise * factor,
-            impact_noise: self.impact_noise * factor,
             ..self
         }
     }
@@ -229,14 +188,6 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             if !(a >= T::zero() && a.is_finite()) {
                 return bad("accel_noise", a);
             }
-        }
-        for &a in self.contact_noise.iter() {
-            if !(a >= T::zero() && a.is_finite()) {
-                return bad("contact_noise", a);
-            }
-        }
-        if !(self.impact_noise >= T::zero() && self.impact_noise.is_finite()) {
-            return bad("impact_noise", self.impact_noise);
         }
         let r = &self.measurement;
         for i in 0..N {
@@ -558,8 +509,6 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
                 .params
                 .accel_noise
                 .component_mul(&self.params.accel_noise),
-            impact_noise: self.params.impact_noise,
-            events: false,
             p: self.p,
             correction: (SVector::zeros(), SVector::zeros()),
             saltations: 0,
@@ -571,20 +520,6 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             v_pred + propagation.correction.1,
         );
         let mut p = propagation.p;
-        if propagation.events {
-            // an interval with an impact or a contact: the contact's noise
-            // over the whole interval, beyond the flight's already added
-            let extra = (self
-                .params
-                .contact_noise
-                .component_mul(&self.params.contact_noise)
-                - propagation.density)
-                .map(|x| x.max(T::zero()));
-            let q_extra = process_noise(&extra, t - self.t);
-            p = p
-                .add(&Blocks::diagonal(q_extra.qq, q_extra.vv))
-                .symmetrized();
-        }
         let mut kalman = KalmanReport {
             saltations: propagation.saltations,
             projections: propagation.projections,
@@ -681,11 +616,6 @@ where
     bound: T,
     /// `q_a²` per coordinate.
     density: SVector<T, N>,
-    /// Relative uncertainty of a velocity jump.
-    impact_noise: T,
-    /// Whether the interval held an impact or a persistent contact (its
-    /// covariance then gets the contact noise on top of the flight's).
-    events: bool,
     p: Blocks<T, N>,
     /// The move of the predicted end onto the contact manifold, when the
     /// last piece was a persistent contact.
@@ -731,7 +661,6 @@ where
         } else {
             constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
         };
-        self.events |= !held.is_empty();
         let noise = process_noise(&self.density, piece.h);
         let mut p = transition(&a, piece.h).congruence(&self.p);
         self.correction = (SVector::zeros(), SVector::zeros());
@@ -778,7 +707,6 @@ where
         if active.is_empty() {
             return Ok(());
         }
-        self.events = true;
         // the impact time moves with the constraint whose root timed it
         // (the fastest-approaching if several), for an elastic law only
         let (_, jac) = self.model.contact(jump.p);
@@ -810,15 +738,6 @@ where
             guard,
         )?;
         self.p = s.matrix.congruence(&self.p);
-        if self.impact_noise > T::zero() {
-            // Δv = M⁻¹ Jᵀ λ
-            let mass = factor_mass(&self.model.mass(jump.p))?;
-            let dv = mass.solve(&(jac.transpose() * jump.lambda)) * self.impact_noise;
-            self.p = self.p.add(&Blocks::diagonal(
-                SMatrix::zeros(),
-                SMatrix::identity() * dv.norm_squared(),
-            ));
-        }
         self.saltations += 1;
         Ok(())
     }

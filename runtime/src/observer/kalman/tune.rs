@@ -14,7 +14,7 @@ use super::{KalmanParams, KalmanReport, SaltationKalman};
 pub struct Tuning<T: RealField + Copy, const N: usize> {
     /// The settings with the chosen process noise.
     pub params: KalmanParams<T, N>,
-    /// The factor applied to the given `accel_noise` (the flight's).
+    /// The factor applied to the given `accel_noise`.
     pub factor: T,
     /// The innovation log-likelihood of the run at that factor,
     /// `Σ_k −½ (y_kᵀS_k⁻¹y_k + ln det S_k + N ln 2π)`.
@@ -24,15 +24,11 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
 }
 
 /// Picks the process noise of `params` for a recorded run by maximising
-/// the innovation log-likelihood over three factors in `[10^lo, 10^hi]`,
-/// one on each knob: [`KalmanParams::accel_noise`] (flight),
-/// [`KalmanParams::contact_noise`] (intervals with an impact or a
-/// contact) and [`KalmanParams::impact_noise`]. First one common factor,
-/// then each factor in turn, twice; each one-dimensional search is a grid
-/// of nine points in `log s`, then golden-section search (24 steps) around
-/// the best point of the grid. Each evaluation runs a filter over the
-/// record from `(t[0], q[0])` with the velocity estimate `v0`; nothing
-/// allocates.
+/// the innovation log-likelihood over a factor `s` applied to
+/// [`KalmanParams::accel_noise`], `s ∈ [10^lo, 10^hi]`: a grid of nine
+/// points in `log s`, then golden-section search (24 steps) around the
+/// best point of the grid. Each evaluation runs a filter over the record
+/// from `(t[0], q[0])` with the velocity estimate `v0`; nothing allocates.
 ///
 /// A user with data does not tune by hand: the likelihood is largest where
 /// the innovations are as large as the filter expects them, neither
@@ -113,17 +109,9 @@ where
     }
     let ten: T = nalgebra::convert(10.0);
     let mut evaluations = 0u32;
-    // the three knobs as log10 factors on the given noises: flight
-    // acceleration, contact acceleration, impact
-    let with = |x: [T; 3]| KalmanParams {
-        accel_noise: params.accel_noise * ten.powf(x[0]),
-        contact_noise: params.contact_noise * ten.powf(x[1]),
-        impact_noise: params.impact_noise * ten.powf(x[2]),
-        ..params
-    };
-    let mut likelihood = |x: [T; 3]| -> Result<T, ObserverError<T>> {
+    let mut likelihood = |x: T| -> Result<T, ObserverError<T>> {
         evaluations += 1;
-        let p = with(x);
+        let p = params.scaled(ten.powf(x));
         let mut filter = SaltationKalman::<T, N, K>::new(p, t[0], q[0], *v0)?;
         let mut total = T::zero();
         for (&tk, qk) in t.iter().zip(q).skip(1) {
@@ -140,64 +128,43 @@ where
         }
         Ok(total)
     };
-    // one common factor first, then each knob in turn, twice
-    let (x, mut best) = maximize(&mut |c| likelihood([c, c, c]), (lo, hi))?;
-    let mut point = [x; 3];
-    for _ in 0..2 {
-        for k in 0..3 {
-            let (xk, l) = maximize(
-                &mut |c| {
-                    let mut trial = point;
-                    trial[k] = c;
-                    likelihood(trial)
-                },
-                (lo, hi),
-            )?;
-            if l > best {
-                (point[k], best) = (xk, l);
-            }
-        }
-    }
-    Ok(Tuning {
-        params: with(point),
-        factor: ten.powf(point[0]),
-        log_likelihood: best,
-        evaluations,
-    })
-}
-
-/// The maximum of `f` over `[lo, hi]`: a grid of nine points, then
-/// golden-section search (24 steps) around the best of them.
-fn maximize<T: RealField + Copy>(
-    f: &mut dyn FnMut(T) -> Result<T, ObserverError<T>>,
-    (lo, hi): (T, T),
-) -> Result<(T, T), ObserverError<T>> {
+    // a grid in log s, then golden-section search around its best point
     const GRID: usize = 9;
     let step = (hi - lo) / nalgebra::convert((GRID - 1) as f64);
-    let (mut best_x, mut best) = (lo, f(lo)?);
-    for j in 1..GRID {
+    let (mut best_x, mut best) = (
+        lo,
+        T::min_value().unwrap_or(-T::one() / T::default_epsilon()),
+    );
+    let mut first = true;
+    for j in 0..GRID {
         let x = lo + step * nalgebra::convert(j as f64);
-        let l = f(x)?;
-        if l > best {
-            (best_x, best) = (x, l);
+        let l = likelihood(x)?;
+        if first || l > best {
+            (best_x, best, first) = (x, l, false);
         }
     }
     let ratio: T = nalgebra::convert(0.618_033_988_749_895);
     let (mut a, mut b) = ((best_x - step).max(lo), (best_x + step).min(hi));
     let mut c = b - (b - a) * ratio;
     let mut d = a + (b - a) * ratio;
-    let (mut fc, mut fd) = (f(c)?, f(d)?);
+    let (mut fc, mut fd) = (likelihood(c)?, likelihood(d)?);
     for _ in 0..24 {
         if fc > fd {
             (b, d, fd) = (d, c, fc);
             c = b - (b - a) * ratio;
-            fc = f(c)?;
+            fc = likelihood(c)?;
         } else {
             (a, c, fc) = (c, d, fd);
             d = a + (b - a) * ratio;
-            fd = f(d)?;
+            fd = likelihood(d)?;
         }
     }
     let (x, l) = if fc > fd { (c, fc) } else { (d, fd) };
-    Ok(if l > best { (x, l) } else { (best_x, best) })
+    let (x, l) = if l > best { (x, l) } else { (best_x, best) };
+    Ok(Tuning {
+        params: params.scaled(ten.powf(x)),
+        factor: ten.powf(x),
+        log_likelihood: l,
+        evaluations,
+    })
 }
