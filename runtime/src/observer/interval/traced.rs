@@ -152,9 +152,8 @@ where
                 let rate0 = jac * w;
                 let rate1 = jac1 * arc.w;
                 let band = self.params.contact_band();
-                let bands = SVector::<T, K>::from_fn(|i, _| jac.row(i).norm() * band);
                 if let Some(Crossing { at, set }) =
-                    self.first_crossing(&seg, &c, &bands, (&h, &rate0), (&h1, &rate1))?
+                    self.first_crossing(&seg, &c, (&jac, band), (&h, &rate0), (&h1, &rate1))?
                 {
                     let part = self.rk4(&point, at, c.sliding, report)?;
                     tracer.flight(&Flight {

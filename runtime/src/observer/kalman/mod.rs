@@ -70,7 +70,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Sensitivities;
 
-use super::interval::{Flight, Interval, Jump, Memory, Tracer, saturate};
+use super::interval::{Cache, Flight, Interval, Jump, Memory, Tracer, saturate};
 use super::{Estimate, ObserverError, ObserverParams, UpdateReport};
 use crate::error::DataError;
 use crate::validate::{self, factor_mass};
@@ -490,7 +490,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             restitution: self.restitution,
             report: &self.report,
         };
-        let (mut interval, mut report) = Interval::begin(model, u, memory, t, q)?;
+        let (mut interval, mut report) =
+            Interval::begin(model, u, memory, &mut Cache::default(), t, q)?;
         let sigma = rule.noise;
         interval.gain = if sigma > T::zero() {
             sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
