@@ -288,6 +288,8 @@ mod report;
 
 pub use error::ObserverError;
 pub use full_order::{FullOrder, FullOrderGains};
+#[cfg(feature = "std")]
+pub use gains::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};
 pub use gains::{Design, GainRegion, ModelBounds};
 pub use params::{Discretization, ObserverParams};
 pub use reduced_order::ReducedOrder;
