@@ -2,26 +2,38 @@
 //! in an interval matrix (`[row][col]`, as [`Enclosure`](crate::Enclosure)
 //! returns them).
 //!
-//! Every interval matrix `[A]` is split into a midpoint `A_c` (a floating
-//! point matrix) and a radius `R ≥ 0` rounded up, so that every `A ∈ [A]`
-//! is `A_c + E` with `|E_ij| ≤ R_ij`. Then:
+//! **Eigenvalues of a symmetric family** (the mass matrix; entry `(i, j)`
+//! is first intersected with `(j, i)`, both enclosing the same real):
 //!
-//! - **symmetric `[A]`** (the mass matrix; entry `(i, j)` is intersected
-//!   with `(j, i)`, both enclosing the same real): by Weyl's inequality
-//!   `λ_min(A) ≥ λ_min(A_c) − ‖E‖₂` and `‖E‖₂ ≤ ‖ |E| ‖₂ ≤ ‖R‖₂`
-//!   (Perron–Frobenius), bounded by `min(‖R‖_F, ‖R‖_∞)` rounded up
-//!   (`R` is symmetric, so `‖R‖₂ ≤ √(‖R‖₁‖R‖_∞) = ‖R‖_∞`). `λ_min(A_c)` is
-//!   found by Jacobi, then **verified**: `s = λ̃ − δ` is a proven lower
-//!   bound when the Cholesky factorization of `A_c − sI` in interval
-//!   arithmetic succeeds (every pivot's lower bound `> 0` proves the exact
-//!   real matrix positive definite); `δ` starts at `10⁻¹⁴ max|A_c|` and
-//!   grows 16-fold up to six times, then Gershgorin's
-//!   `min_i (a_ii − Σ_{j≠i} |a_ij|)` (rounded down) is the fallback.
-//!   `λ_max` the same way on `−A`.
-//! - **any `[A]`** (`C(q, d)`, `∂F/∂v`): `‖A‖₂ ≤ ‖A_c‖₂ + ‖R‖₂` with
-//!   `‖A_c‖₂ = √λ_max(A_cᵀA_c)`, the Gram matrix computed in interval
-//!   arithmetic and bounded as above, and
-//!   `‖R‖₂ ≤ min(‖R‖_F, √(‖R‖₁‖R‖_∞))`.
+//! 1. the midpoint `A_c` is diagonalised approximately by cyclic Jacobi,
+//!    `A_c ≈ V Λ Vᵀ`, columns ordered by decreasing eigenvalue;
+//! 2. `B = Vᵀ A V` is enclosed in interval arithmetic, for the family in
+//!    mean-value form ([`MeanValueMatrix`]: `A(q) ∈ A(c) + Σ_m ∂A/∂q_m (Q)
+//!    (Q_m − c_m)`) by applying the congruence to the centre and to each
+//!    slope separately, so that entries keep their correlations to first
+//!    order;
+//! 3. `λ_min(B) ≥ s` is **proven** when the interval Cholesky factorization
+//!    of `B − sI` succeeds (every pivot's lower bound `> 0`: then every
+//!    symmetric real matrix of the interval matrix is positive definite).
+//!    The smallest eigenvalue is eliminated last, so its pivot is the
+//!    Schur complement, second order in the off-diagonal widths. `s` starts
+//!    at `λ̃_min − w` (`w` the width of `B`'s last diagonal entry), backs off
+//!    by doubling, then is refined by six bisections;
+//! 4. `V` is orthogonal only to rounding: with `ε ≥ ‖VᵀV − I‖₂` (row sums
+//!    of the interval matrix `VᵀV − I`, rounded up), Ostrowski's theorem
+//!    gives `λ_min(A) ≥ s/(1 + ε)` for `s ≥ 0` and `s/(1 − ε)` otherwise;
+//! 5. Gershgorin's `min_i (a_ii − Σ_{j≠i} |a_ij|)` (rounded down) on the
+//!    interval matrix is a fallback, and the larger of the proven bounds is
+//!    kept (for the mean-value family, also the bound of the plain
+//!    interval matrix, which is often the tighter for `λ_max`).
+//!
+//! `λ_max(A) = −λ_min(−A)`.
+//!
+//! **Norms** (`C(q, d)`, `∂F/∂v`): with the midpoint `A_c` and the radius
+//! `R ≥ 0` rounded up, every `A` of `[A]` is `A_c + E`, `|E_ij| ≤ R_ij`, so
+//! `‖A‖₂ ≤ ‖A_c‖₂ + ‖R‖₂` (`‖E‖₂ ≤ ‖ |E| ‖₂ ≤ ‖R‖₂`, Perron–Frobenius),
+//! with `‖A_c‖₂ = √λ_max(A_cᵀA_c)` (the Gram matrix in interval arithmetic,
+//! bounded as above) and `‖R‖₂ ≤ min(‖R‖_F, √(‖R‖₁‖R‖_∞))`.
 
 // index loops read as the formulas they implement
 #![allow(clippy::needless_range_loop)]
@@ -199,18 +211,29 @@ impl<const N: usize> MeanValueMatrix<N> {
         b
     }
 
-    /// The variable the family depends on most over the box (the largest
-    /// `Σ_ij |slope_m,ij| · width(delta_m)`): where to bisect.
-    pub fn smear(&self) -> usize {
+    /// The variable the eigenvalue at the end `smallest` (else the largest)
+    /// of the spectrum depends on most over the box: the largest
+    /// `Σ_ij |u_i| |slope_m,ij| |u_j| · width(delta_m)`, `u` the midpoint's
+    /// eigenvector there. Where to bisect.
+    pub fn smear(&self, smallest: bool) -> usize {
+        let (c, _) = mid_rad(&self.centre);
+        let (values, vectors) = jacobi(&c);
+        let mut k = 0;
+        for j in 1..N {
+            if (values[j] < values[k]) == smallest {
+                k = j;
+            }
+        }
+        let u: [f64; N] = core::array::from_fn(|i| vectors[i][k].abs());
         let mut best = (f64::NEG_INFINITY, 0);
         for m in 0..N {
-            let w = self.delta[m].width();
-            let s = self.slopes[m]
-                .iter()
-                .flatten()
-                .map(|x| x.mag())
-                .sum::<f64>()
-                * w;
+            let mut s = 0.0;
+            for i in 0..N {
+                for j in 0..N {
+                    s += u[i] * self.slopes[m][i][j].mag() * u[j];
+                }
+            }
+            let s = s * self.delta[m].width();
             if s > best.0 {
                 best = (s, m);
             }
