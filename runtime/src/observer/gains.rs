@@ -34,8 +34,13 @@
 //!   extra forces that are not).
 //!
 //! Sampling finds a supremum from below: the estimates are what the
-//! samples show, not bounds. Where the guarantee matters, add a margin to
-//! `β` or sample more.
+//! samples show, not bounds. Where the guarantee matters, use
+//! [`CertifiedBounds::certify`] (feature `std`), which proves them: interval
+//! enclosures of the generated code in mean-value form, verified
+//! eigenvalue and norm bounds, and a branch and bound within a budget of
+//! cells, with a report of the worst box and the gap of each constant (see
+//! its docs and `runtime/src/interval/`). The sampled estimate stays the
+//! quick look: milliseconds, and within the proven bound.
 //!
 //! # The gain
 //!
