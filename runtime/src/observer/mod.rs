@@ -289,6 +289,8 @@ mod report;
 
 pub use error::ObserverError;
 pub use full_order::{FullOrder, FullOrderGains};
+#[cfg(feature = "std")]
+pub use gains::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};
 pub use gains::{Design, GainRegion, ModelBounds};
 pub use kalman::{
     Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
