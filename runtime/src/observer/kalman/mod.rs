@@ -343,8 +343,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidParams`] for a setting out of its range,
-    /// [`ObserverError::NonFiniteMeasurement`] (`"q0"`, `"v0"`) or
+    /// [`DataError::InvalidParams`](crate::DataError::InvalidParams) for a setting out of its range,
+    /// [`DataError::NonFinite`](crate::DataError::NonFinite) (`"q0"`, `"v0"`) or
     /// [`ObserverError::InvalidTime`] for non-finite initial data.
     pub fn new(
         params: KalmanParams<T, N>,
@@ -363,7 +363,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     ///
     /// # Errors
     ///
-    /// As [`SaltationKalman::new`], and [`ObserverError::InvalidParams`]
+    /// As [`SaltationKalman::new`], and [`DataError::InvalidParams`](crate::DataError::InvalidParams)
     /// (`"p0"`) for a non-finite or non-symmetric `p0` or a negative
     /// variance.
     pub fn with_covariance(
@@ -412,7 +412,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     ///
     /// # Errors
     ///
-    /// [`ObserverError::InvalidRestitution`] for a coefficient outside
+    /// [`DataError::InvalidRestitution`](crate::DataError::InvalidRestitution) for a coefficient outside
     /// `[0, 1]`.
     pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, T> {
         validate::restitution(&restitution)?;

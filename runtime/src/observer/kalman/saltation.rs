@@ -67,8 +67,8 @@ type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 ///
 /// # Errors
 ///
-/// [`ObserverError::NonFiniteModel`] or
-/// [`ObserverError::MassNotPositiveDefinite`] where the model fails.
+/// [`DataError::NonFiniteModel`](crate::DataError::NonFiniteModel) or
+/// [`DataError::MassNotPositiveDefinite`](crate::DataError::MassNotPositiveDefinite) where the model fails.
 #[allow(clippy::type_complexity)]
 pub fn flow_jacobian<M, T, const N: usize, const K: usize>(
     model: &M,
@@ -342,9 +342,9 @@ pub struct Saltation<T: RealField + Copy, const N: usize, const K: usize> {
 ///
 /// # Errors
 ///
-/// [`ObserverError::NonFiniteModel`] or
-/// [`ObserverError::MassNotPositiveDefinite`] where the model fails,
-/// [`ObserverError::InvalidParams`] (`"active"`) when the active rows of
+/// [`DataError::NonFiniteModel`](crate::DataError::NonFiniteModel) or
+/// [`DataError::MassNotPositiveDefinite`](crate::DataError::MassNotPositiveDefinite) where the model fails,
+/// [`DataError::InvalidParams`](crate::DataError::InvalidParams) (`"active"`) when the active rows of
 /// `J` are dependent (`W` singular).
 #[allow(clippy::too_many_arguments)]
 pub fn saltation<M, T, const N: usize, const K: usize>(

@@ -84,7 +84,7 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
 ///
 /// # Errors
 ///
-/// [`ObserverError::InvalidParams`] (`"record"`) when `t` and `q` differ in
+/// [`DataError::InvalidParams`](crate::DataError::InvalidParams) (`"record"`) when `t` and `q` differ in
 /// length or hold fewer than two samples, or `lo ≥ hi`; any error of the
 /// filter's construction or updates on the record.
 #[allow(clippy::too_many_arguments)]
