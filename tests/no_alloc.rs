@@ -6,8 +6,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use moreau::{
-    Discretization, FullOrder, FullOrderGains, Model, MoreauJean, Observer, ObserverParams,
-    ReducedOrder, State, StepParams,
+    Discretization, FullOrder, FullOrderGains, KalmanParams, Model, MoreauJean, Observer,
+    ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, State, StepParams,
+    tune_process_noise,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
@@ -165,6 +166,75 @@ fn observing_every_shipped_model_allocates_nothing() {
     assert_eq!((count, impacts > 0), (0, true));
     let (q, v) = Arm3::<f64>::initial_state();
     let (count, _) = observe::<_, 3, 1, 3>(&Arm3::<f64>::default(), q, v, 20_000);
+    assert_eq!(count, 0);
+}
+
+/// The saltation Kalman filter through the same runs (impacts,
+/// accumulations, sliding, several contacts), and the likelihood helper's
+/// evaluations over a record: nothing allocates.
+fn filter<M, const N: usize, const K: usize, const NU: usize>(
+    model: &M,
+    q0: SVector<f64, N>,
+    v0: SVector<f64, N>,
+    steps: usize,
+) -> (usize, u32)
+where
+    M: Sensitivities<N, K, Scalar = f64, Input = SVector<f64, NU>>,
+{
+    let stepper = MoreauJean::new(StepParams::new(1e-4)).unwrap();
+    let mut state = State::new(0.0, q0, v0);
+    let u = SVector::<f64, NU>::repeat(0.1);
+    let mut t = vec![0.0];
+    let mut q = vec![q0];
+    for k in 1..=steps {
+        stepper.step(model, &mut state, &u).unwrap();
+        if k % 10 == 0 {
+            let wiggle = 1e-7 * ((k / 10) % 7) as f64;
+            t.push(state.t);
+            q.push(state.q.add_scalar(wiggle));
+        }
+    }
+    let mut saltations = 0;
+    let params = KalmanParams::new(50.0, 1e-7);
+    let count = allocations(|| {
+        let mut f = SaltationKalman::<f64, N, K>::new(params, 0.0, q0, SVector::zeros()).unwrap();
+        for (tk, qk) in t.iter().zip(&q).skip(1) {
+            std::hint::black_box(f.update(model, *tk, qk, &u).unwrap());
+            saltations += f.kalman_report().saltations;
+        }
+        let record = (&t[..t.len().min(200)], &q[..q.len().min(200)]);
+        std::hint::black_box(
+            tune_process_noise::<_, _, N, K>(
+                model,
+                params,
+                record.0,
+                record.1,
+                &SVector::zeros(),
+                &u,
+                (-2.0, 2.0),
+            )
+            .unwrap(),
+        );
+    });
+    (count, saltations)
+}
+
+#[test]
+fn filtering_every_shipped_model_allocates_nothing() {
+    let (q, v) = Parabola::<f64>::initial_state();
+    let (count, saltations) = filter::<_, 2, 2, 0>(&Parabola::<f64>::default(), q, v, 60_000);
+    assert_eq!((count, saltations > 0), (0, true));
+    let (q, v) = ThreeBalls::<f64>::initial_state();
+    let (count, saltations) = filter::<_, 3, 4, 0>(&ThreeBalls::<f64>::default(), q, v, 20_000);
+    assert_eq!((count, saltations > 0), (0, true));
+    let (q, v) = Billiard::<f64>::initial_state();
+    let (count, saltations) = filter::<_, 2, 4, 0>(&Billiard::<f64>::default(), q, v, 20_000);
+    assert_eq!((count, saltations > 0), (0, true));
+    let (q, v) = DoublePendulum::<f64>::initial_state();
+    let (count, saltations) = filter::<_, 2, 2, 0>(&DoublePendulum::<f64>::default(), q, v, 40_000);
+    assert_eq!((count, saltations > 0), (0, true));
+    let (q, v) = Arm3::<f64>::initial_state();
+    let (count, _) = filter::<_, 3, 1, 3>(&Arm3::<f64>::default(), q, v, 20_000);
     assert_eq!(count, 0);
 }
 

@@ -1,6 +1,17 @@
 //! One time step of the plant stepper, and one update of each observer, on
-//! each shipped model, in free flight and with active constraints (impacts,
-//! persistent contact).
+//! each shipped model (and Example 1 in `f32`), in free flight and with
+//! active constraints, from states of a real run.
+//!
+//! The plant runs 5000 steps of 1 ms from the model's initial state. Its
+//! benchmark cases are the first step with no active constraint (free
+//! flight) and the step with the most. Each observer (reduced and full
+//! order, impact-aware and Section VII) follows the same run sample by
+//! sample; its cases are its own updates after the first 20 (a warmed,
+//! converged estimate with its memos, as a user's observer has them): the
+//! first in free flight (no impact, no contact), the first with an impact
+//! located in the interval, the first with a persistent contact and no
+//! impact. Each measurement copies the observer as it was before that
+//! update and runs the update.
 //!
 //! `cargo bench -p moreau-bench --bench step`
 
@@ -10,70 +21,121 @@ use moreau::{
     ReducedOrder, State, StepParams,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
-use nalgebra::SVector;
+use nalgebra::{RealField, SVector};
 use std::hint::black_box;
 
-/// A free-flight state, and the state with the most active constraints
-/// with their number.
-type Cases<const N: usize> = (Option<State<f64, N>>, Option<(State<f64, N>, usize)>);
+/// Steps in the run the cases are taken from.
+const STEPS: usize = 5000;
+/// Updates an observer makes before its cases are taken.
+const WARM: usize = 20;
 
-/// Runs the model from its initial state and keeps the first state whose
-/// step has no active constraint (free flight; the three balls have none:
-/// balls 2 and 3 stay in contact) and the state whose step has the most
-/// active constraints.
-fn states<M, const N: usize, const K: usize, const NU: usize>(
-    model: &M,
-    q0: SVector<f64, N>,
-    v0: SVector<f64, N>,
-) -> Cases<N>
-where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
-{
-    let stepper = MoreauJean::new(StepParams::new(1e-3)).unwrap();
-    let u = SVector::zeros();
-    let mut state = State::new(0.0, q0, v0);
-    let mut free = None;
-    let mut busiest: Option<(State<f64, N>, usize)> = None;
-    for _ in 0..5000 {
-        let before = state;
-        let report = stepper.step(model, &mut state, &u).unwrap();
-        let active = report.active.len();
-        if active == 0 && free.is_none() {
-            free = Some(before);
-        }
-        if active > 0 && busiest.is_none_or(|(_, n)| active > n) {
-            busiest = Some((before, active));
-        }
-    }
-    (free, busiest)
+/// The plant's run: every state, and the index of the free-flight step and
+/// of the busiest step with its number of active constraints.
+struct Run<T: RealField + Copy, const N: usize> {
+    states: Vec<State<T, N>>,
+    free: Option<usize>,
+    busiest: Option<(usize, usize)>,
 }
 
-fn bench_model<M, const N: usize, const K: usize, const NU: usize>(
+fn run<M, T, const N: usize, const K: usize, const NU: usize>(
+    model: &M,
+    stepper: &MoreauJean<T>,
+    (q0, v0): (SVector<T, N>, SVector<T, N>),
+) -> Run<T, N>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T, Input = SVector<T, NU>>,
+{
+    let u = SVector::zeros();
+    let mut state = State::new(T::zero(), q0, v0);
+    let mut run = Run {
+        states: vec![state],
+        free: None,
+        busiest: None,
+    };
+    for k in 0..STEPS {
+        let report = stepper.step(model, &mut state, &u).unwrap();
+        run.states.push(state);
+        let active = report.active.len();
+        if active == 0 && run.free.is_none() {
+            run.free = Some(k);
+        }
+        if active > 0 && run.busiest.is_none_or(|(_, n)| active > n) {
+            run.busiest = Some((k, active));
+        }
+    }
+    run
+}
+
+/// An observer following the run; returns it as it was before its first
+/// update (after `WARM`) in free flight, with an impact, and in contact.
+fn observer_cases<M, O, T, const N: usize, const K: usize, const NU: usize>(
+    model: &M,
+    states: &[State<T, N>],
+    mut observer: O,
+) -> Vec<(&'static str, O, State<T, N>)>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T, Input = SVector<T, NU>>,
+    O: Observer<T, N, K> + Copy,
+{
+    let u = SVector::zeros();
+    let mut cases: Vec<(&'static str, O, State<T, N>)> = Vec::new();
+    for (k, next) in states.iter().enumerate().skip(1) {
+        let before = observer;
+        observer.update(model, next.t, &next.q, &u).unwrap();
+        if k <= WARM {
+            continue;
+        }
+        let report = observer.report();
+        let label = if report.impacts > 0 {
+            "impact"
+        } else if !report.contacts.is_empty() || !report.active.is_empty() {
+            "contact"
+        } else {
+            "free flight"
+        };
+        if cases.iter().all(|(l, _, _)| *l != label) {
+            cases.push((label, before, *next));
+        }
+    }
+    cases.sort_by_key(|(l, _, _)| match *l {
+        "free flight" => 0,
+        "impact" => 1,
+        _ => 2,
+    });
+    cases
+}
+
+fn bench_model<M, T, const N: usize, const K: usize, const NU: usize>(
     c: &mut Criterion,
     name: &str,
     model: M,
-    q0: SVector<f64, N>,
-    v0: SVector<f64, N>,
+    start: (SVector<T, N>, SVector<T, N>),
 ) where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T, Input = SVector<T, NU>>,
 {
-    let stepper = MoreauJean::new(StepParams::new(1e-3)).unwrap();
-    let u = SVector::<f64, NU>::zeros();
-    let (free, busiest) = states::<M, N, K, NU>(&model, q0, v0);
+    let tau: T = nalgebra::convert(1e-3);
+    let stepper = MoreauJean::new(StepParams::new(tau)).unwrap();
+    let u = SVector::<T, NU>::zeros();
+    let run = run::<M, T, N, K, NU>(&model, &stepper, start);
     let mut group = c.benchmark_group(format!("step/{name}"));
-    if let Some(free) = free {
+    if let Some(k) = run.free {
+        let state = run.states[k];
         group.bench_function("free flight", |b| {
             b.iter(|| {
-                let mut s = black_box(free);
+                let mut s = black_box(state);
                 stepper.step(&model, &mut s, &u).unwrap();
                 s
             })
         });
     }
-    if let Some((contact, active)) = busiest {
+    if let Some((k, active)) = run.busiest {
+        let state = run.states[k];
         group.bench_function(format!("{active} active"), |b| {
             b.iter(|| {
-                let mut s = black_box(contact);
+                let mut s = black_box(state);
                 stepper.step(&model, &mut s, &u).unwrap();
                 s
             })
@@ -81,36 +143,34 @@ fn bench_model<M, const N: usize, const K: usize, const NU: usize>(
     }
     group.finish();
 
-    // observers: one update from a converged estimate, 1 ms after the state
     let mut group = c.benchmark_group(format!("observer/{name}"));
-    let mut cases: Vec<(&str, State<f64, N>)> =
-        free.map(|f| ("free flight", f)).into_iter().collect();
-    if let Some((contact, active)) = busiest {
-        cases.push((if active > 1 { "contacts" } else { "contact" }, contact));
-    }
-    for (label, start) in cases {
-        let mut next = start;
-        stepper.step(&model, &mut next, &u).unwrap();
-        for scheme in [Discretization::ImpactAware, Discretization::SectionVii] {
-            let params = ObserverParams::new(10.0, 50.0).with_scheme(scheme);
-            let tag = match scheme {
-                Discretization::ImpactAware => "impact-aware",
-                Discretization::SectionVii => "section-vii",
-            };
-            let reduced =
-                ReducedOrder::<f64, N, K>::new(params, start.t, start.q, start.v).unwrap();
+    let (l_d, bound): (T, T) = (nalgebra::convert(10.0), nalgebra::convert(50.0));
+    let s0 = run.states[0];
+    for scheme in [Discretization::ImpactAware, Discretization::SectionVii] {
+        let params = ObserverParams::new(l_d, bound).with_scheme(scheme);
+        let tag = match scheme {
+            Discretization::ImpactAware => "impact-aware",
+            Discretization::SectionVii => "section-vii",
+        };
+        let reduced = ReducedOrder::<T, N, K>::new(params, s0.t, s0.q, s0.v).unwrap();
+        for (label, observer, next) in
+            observer_cases::<M, _, T, N, K, NU>(&model, &run.states, reduced)
+        {
             group.bench_function(format!("reduced {tag}, {label}"), |b| {
                 b.iter(|| {
-                    let mut o = black_box(reduced);
+                    let mut o = black_box(observer);
                     o.update(&model, next.t, &next.q, &u).unwrap()
                 })
             });
-            let gains = FullOrderGains::scalar(10.0, 10.0);
-            let full =
-                FullOrder::<f64, N, K>::new(params, gains, start.t, start.q, start.v).unwrap();
+        }
+        let gains = FullOrderGains::scalar(l_d, l_d);
+        let full = FullOrder::<T, N, K>::new(params, gains, s0.t, s0.q, s0.v).unwrap();
+        for (label, observer, next) in
+            observer_cases::<M, _, T, N, K, NU>(&model, &run.states, full)
+        {
             group.bench_function(format!("full {tag}, {label}"), |b| {
                 b.iter(|| {
-                    let mut o = black_box(full);
+                    let mut o = black_box(observer);
                     o.update(&model, next.t, &next.q, &u).unwrap()
                 })
             });
@@ -120,16 +180,42 @@ fn bench_model<M, const N: usize, const K: usize, const NU: usize>(
 }
 
 fn steps(c: &mut Criterion) {
-    let (q, v) = Parabola::<f64>::initial_state();
-    bench_model::<_, 2, 2, 0>(c, "parabola", Parabola::<f64>::default(), q, v);
-    let (q, v) = ThreeBalls::<f64>::initial_state();
-    bench_model::<_, 3, 4, 0>(c, "three_balls", ThreeBalls::<f64>::default(), q, v);
-    let (q, v) = Billiard::<f64>::initial_state();
-    bench_model::<_, 2, 4, 0>(c, "billiard", Billiard::<f64>::default(), q, v);
-    let (q, v) = DoublePendulum::<f64>::initial_state();
-    bench_model::<_, 2, 2, 0>(c, "double_pendulum", DoublePendulum::<f64>::default(), q, v);
-    let (q, v) = Arm3::<f64>::initial_state();
-    bench_model::<_, 3, 1, 3>(c, "arm3", Arm3::<f64>::default(), q, v);
+    bench_model::<_, _, 2, 2, 0>(
+        c,
+        "parabola",
+        Parabola::<f64>::default(),
+        Parabola::<f64>::initial_state(),
+    );
+    bench_model::<_, _, 2, 2, 0>(
+        c,
+        "parabola-f32",
+        Parabola::<f32>::default(),
+        Parabola::<f32>::initial_state(),
+    );
+    bench_model::<_, _, 3, 4, 0>(
+        c,
+        "three_balls",
+        ThreeBalls::<f64>::default(),
+        ThreeBalls::<f64>::initial_state(),
+    );
+    bench_model::<_, _, 2, 4, 0>(
+        c,
+        "billiard",
+        Billiard::<f64>::default(),
+        Billiard::<f64>::initial_state(),
+    );
+    bench_model::<_, _, 2, 2, 0>(
+        c,
+        "double_pendulum",
+        DoublePendulum::<f64>::default(),
+        DoublePendulum::<f64>::initial_state(),
+    );
+    bench_model::<_, _, 3, 1, 3>(
+        c,
+        "arm3",
+        Arm3::<f64>::default(),
+        Arm3::<f64>::initial_state(),
+    );
 }
 
 criterion_group!(benches, steps);

@@ -1,17 +1,25 @@
-//! CasADi's generated C for the shipped models, callable from the
-//! benchmarks: the anchor that moreau's generated Rust is measured against.
+//! CasADi's generated C for the shipped models and the N-link chains,
+//! callable from the benchmarks: the anchor that moreau's generated Rust is
+//! measured against.
 //!
 //! Each `<model>_eval(t, q, v, u, p) -> (M, C, G, F, h, J)` was written by
 //! `tests/casadi_reference.py` (CasADi SX with `cse = True`) and is compiled
-//! by `build.rs` at `-O3`. Outputs are dense and column-major, as nalgebra
-//! stores matrices, so they are written straight into `SMatrix` buffers.
+//! by `build.rs` at `-O3` for the same target CPU as the Rust. Outputs are
+//! dense and column-major, as nalgebra stores matrices.
+//!
+//! Two ways to call one: [`CasadiFn`] directly, as a C user does (argument
+//! and result pointer arrays set up once, one call per evaluation), and
+//! [`CasadiModel::eval`], a safe wrapper that builds the pointer arrays and
+//! checks the status on every call (the way a Rust user might wrap it; it
+//! costs a few nanoseconds a C user does not pay).
 
 use std::os::raw::c_int;
 
 use nalgebra::{SMatrix, SVector};
 
-/// The signature of a CasADi-generated function.
-type Eval = unsafe extern "C" fn(
+/// The signature of a CasADi-generated function:
+/// `int f(const double** arg, double** res, casadi_int* iw, double* w, int mem)`.
+pub type CasadiFn = unsafe extern "C" fn(
     arg: *const *const f64,
     res: *const *mut f64,
     iw: *mut i64,
@@ -19,47 +27,43 @@ type Eval = unsafe extern "C" fn(
     mem: c_int,
 ) -> c_int;
 
-unsafe extern "C" {
-    fn parabola_eval(
-        a: *const *const f64,
-        r: *const *mut f64,
-        iw: *mut i64,
-        w: *mut f64,
-        m: c_int,
-    ) -> c_int;
-    fn three_balls_eval(
-        a: *const *const f64,
-        r: *const *mut f64,
-        iw: *mut i64,
-        w: *mut f64,
-        m: c_int,
-    ) -> c_int;
-    fn billiard_eval(
-        a: *const *const f64,
-        r: *const *mut f64,
-        iw: *mut i64,
-        w: *mut f64,
-        m: c_int,
-    ) -> c_int;
-    fn double_pendulum_eval(
-        a: *const *const f64,
-        r: *const *mut f64,
-        iw: *mut i64,
-        w: *mut f64,
-        m: c_int,
-    ) -> c_int;
-    fn arm3_eval(
-        a: *const *const f64,
-        r: *const *mut f64,
-        iw: *mut i64,
-        w: *mut f64,
-        m: c_int,
-    ) -> c_int;
+macro_rules! casadi_functions {
+    ($($name:ident),* $(,)?) => {
+        unsafe extern "C" {
+            $(fn $name(
+                a: *const *const f64,
+                r: *const *mut f64,
+                iw: *mut i64,
+                w: *mut f64,
+                m: c_int,
+            ) -> c_int;)*
+        }
+    };
 }
+
+casadi_functions!(
+    parabola_eval,
+    three_balls_eval,
+    billiard_eval,
+    double_pendulum_eval,
+    arm3_eval,
+    chain02_eval,
+    chain03_eval,
+    chain04_eval,
+    chain05_eval,
+    chain06_eval,
+    chain07_eval,
+    chain08_eval,
+    chain09_eval,
+    chain10_eval,
+    chain11_eval,
+    chain12_eval,
+);
 
 /// A CasADi-generated evaluation of one model, with its output buffers.
 pub struct CasadiModel<const N: usize, const K: usize> {
-    eval: Eval,
+    /// The generated C function, to be called directly.
+    pub function: CasadiFn,
     /// `M(q)`.
     pub mass: SMatrix<f64, N, N>,
     /// `C(q, v)`.
@@ -75,9 +79,9 @@ pub struct CasadiModel<const N: usize, const K: usize> {
 }
 
 impl<const N: usize, const K: usize> CasadiModel<N, K> {
-    fn new(eval: Eval) -> Self {
+    fn new(function: CasadiFn) -> Self {
         Self {
-            eval,
+            function,
             mass: SMatrix::zeros(),
             coriolis: SMatrix::zeros(),
             gravity: SVector::zeros(),
@@ -87,12 +91,28 @@ impl<const N: usize, const K: usize> CasadiModel<N, K> {
         }
     }
 
+    /// The six result pointers into the output buffers, in CasADi's order,
+    /// for calling [`function`](Self::function) directly. They stay valid
+    /// while `self` is neither moved nor dropped.
+    pub fn results(&mut self) -> [*mut f64; 6] {
+        [
+            self.mass.as_mut_ptr(),
+            self.coriolis.as_mut_ptr(),
+            self.gravity.as_mut_ptr(),
+            self.forces.as_mut_ptr(),
+            self.gaps.as_mut_ptr(),
+            self.jacobian.as_mut_ptr(),
+        ]
+    }
+
     /// Evaluates every output at `(t, q, v, u)` with parameters `p` (in the
-    /// model file's order) into the buffers.
+    /// model file's order) into the buffers, through a safe wrapper that
+    /// builds the pointer arrays and checks the status on every call.
     ///
     /// # Panics
     ///
-    /// If CasADi reports an error (it never does for these functions).
+    /// If CasADi reports an error (it never does for these functions), or
+    /// if `u` or `p` is shorter than the model's inputs or parameters.
     pub fn eval(&mut self, t: f64, q: &SVector<f64, N>, v: &SVector<f64, N>, u: &[f64], p: &[f64]) {
         let args = [
             &t as *const f64,
@@ -101,20 +121,13 @@ impl<const N: usize, const K: usize> CasadiModel<N, K> {
             u.as_ptr(),
             p.as_ptr(),
         ];
-        let res = [
-            self.mass.as_mut_ptr(),
-            self.coriolis.as_mut_ptr(),
-            self.gravity.as_mut_ptr(),
-            self.forces.as_mut_ptr(),
-            self.gaps.as_mut_ptr(),
-            self.jacobian.as_mut_ptr(),
-        ];
+        let res = self.results();
         // SAFETY: the functions read N, N, NU and NP values from the
         // argument pointers and write dense outputs of the sizes above (their
         // work sizes are 0), which is what the model's CasADi function was
         // built with in tests/casadi_reference.py.
         let status = unsafe {
-            (self.eval)(
+            (self.function)(
                 args.as_ptr(),
                 res.as_ptr(),
                 std::ptr::null_mut(),
@@ -126,27 +139,45 @@ impl<const N: usize, const K: usize> CasadiModel<N, K> {
     }
 }
 
-/// Example 1.
-pub fn parabola() -> CasadiModel<2, 2> {
-    CasadiModel::new(parabola_eval)
+macro_rules! constructors {
+    ($($(#[$doc:meta])* $name:ident: $f:ident, $n:literal, $k:literal;)*) => {
+        $($(#[$doc])* pub fn $name() -> CasadiModel<$n, $k> {
+            CasadiModel::new($f)
+        })*
+    };
 }
 
-/// Three balls between two walls.
-pub fn three_balls() -> CasadiModel<3, 4> {
-    CasadiModel::new(three_balls_eval)
-}
-
-/// The nonconvex billiard.
-pub fn billiard() -> CasadiModel<2, 4> {
-    CasadiModel::new(billiard_eval)
-}
-
-/// The double pendulum.
-pub fn double_pendulum() -> CasadiModel<2, 2> {
-    CasadiModel::new(double_pendulum_eval)
-}
-
-/// The three-link arm.
-pub fn arm3() -> CasadiModel<3, 1> {
-    CasadiModel::new(arm3_eval)
+constructors! {
+    /// Example 1.
+    parabola: parabola_eval, 2, 2;
+    /// Three balls between two walls.
+    three_balls: three_balls_eval, 3, 4;
+    /// The nonconvex billiard.
+    billiard: billiard_eval, 2, 4;
+    /// The double pendulum.
+    double_pendulum: double_pendulum_eval, 2, 2;
+    /// The three-link arm.
+    arm3: arm3_eval, 3, 1;
+    /// The 2-link chain.
+    chain02: chain02_eval, 2, 2;
+    /// The 3-link chain.
+    chain03: chain03_eval, 3, 3;
+    /// The 4-link chain.
+    chain04: chain04_eval, 4, 4;
+    /// The 5-link chain.
+    chain05: chain05_eval, 5, 5;
+    /// The 6-link chain.
+    chain06: chain06_eval, 6, 6;
+    /// The 7-link chain.
+    chain07: chain07_eval, 7, 7;
+    /// The 8-link chain.
+    chain08: chain08_eval, 8, 8;
+    /// The 9-link chain.
+    chain09: chain09_eval, 9, 9;
+    /// The 10-link chain.
+    chain10: chain10_eval, 10, 10;
+    /// The 11-link chain.
+    chain11: chain11_eval, 11, 11;
+    /// The 12-link chain.
+    chain12: chain12_eval, 12, 12;
 }

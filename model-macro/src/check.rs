@@ -13,7 +13,7 @@ use crate::ctxt::Ctxt;
 use crate::expr::{Expr, ExprKind, POSITION_FUNCTIONS};
 use crate::keys;
 use crate::loc::Loc;
-use crate::resolve::{Scope, Symbol, Var};
+use crate::scope::{Scope, Symbol, Var};
 use crate::spec::{ModelSpec, Name, PRELUDE_VALUES, RESERVED, RUST_KEYWORDS, is_identifier};
 
 /// Runs every check.
@@ -184,7 +184,7 @@ fn expressions(spec: &ModelSpec) -> Vec<(String, &Expr)> {
 fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     for (i, d) in spec.definitions.iter().enumerate() {
         d.expr.visit(&mut |name, loc| match scope.get(name) {
-            None => unknown(cx, name, loc),
+            None => unknown(cx, spec, name, loc),
             Some(Symbol::Definition(j)) if j >= i => cx.error(
                 loc,
                 format!("definition `{name}` is used before it is defined (definitions are read in order)"),
@@ -195,13 +195,16 @@ fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     for (_, e) in expressions(spec).into_iter().skip(spec.definitions.len()) {
         e.visit(&mut |name, loc| {
             if scope.get(name).is_none() {
-                unknown(cx, name, loc);
+                unknown(cx, spec, name, loc);
             }
         });
     }
 }
 
-fn unknown(cx: &Ctxt, name: &str, loc: Loc) {
+fn unknown(cx: &Ctxt, spec: &ModelSpec, name: &str, loc: Loc) {
+    if spec.unreadable.iter().any(|n| n.text == name) {
+        return; // its definition's error is reported already
+    }
     cx.error(
         loc,
         format!("unknown name `{name}`: not a coordinate, velocity, parameter, input or definition of this model"),
@@ -450,7 +453,7 @@ fn check_tree(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
 fn check_body_fields(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     let check = |e: &Expr, what: &str| {
         e.visit(&mut |name, loc| match scope.get(name) {
-            None => unknown(cx, name, loc),
+            None => unknown(cx, spec, name, loc),
             Some(Symbol::Var(Var::Parameter(_)) | Symbol::Pi) => {}
             Some(_) => cx.error(
                 loc,

@@ -8,7 +8,8 @@ use proc_macro2::{TokenStream, TokenTree};
 use crate::ctxt::Ctxt;
 use crate::front::{inline, yaml};
 use crate::lower::Lowered;
-use crate::resolve::{Resolved, Scope};
+use crate::resolve::Resolved;
+use crate::scope::Scope;
 use crate::spec::ModelSpec;
 use crate::{check, emit, lower, resolve};
 

@@ -12,7 +12,8 @@ use moreau_sym::{
 use crate::ctxt::Ctxt;
 use crate::expr::{BinOp, Expr, ExprKind};
 use crate::loc::Loc;
-use crate::resolve::{Resolved, Symbol, Var, VarLayout};
+use crate::resolve::{Resolved, VarLayout};
+use crate::scope::{Symbol, Var};
 use crate::tree;
 
 /// The lowered model: its graph, variable layout and derived mechanics.

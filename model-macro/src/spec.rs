@@ -146,6 +146,9 @@ pub(crate) struct ModelSpec {
     /// Where `bodies` was written (for messages about the tree as a whole).
     pub bodies_loc: Option<Loc>,
     pub origin: Origin,
+    /// Definitions whose expression could not be read (the front end has
+    /// reported why): their uses are not reported again as unknown names.
+    pub unreadable: Vec<Name>,
 }
 
 /// Names the language reserves: the time and the constant π.

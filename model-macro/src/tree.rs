@@ -31,7 +31,8 @@
 
 use moreau_sym::{Graph, Id};
 
-use crate::resolve::{TreeBody, Var, VarLayout};
+use crate::resolve::{TreeBody, VarLayout};
+use crate::scope::Var;
 use crate::spec::JointKind;
 
 type V3 = [Id; 3];

@@ -8,6 +8,7 @@
 //! | [`Billiard`] | `billiard.yaml` | 2 | 4 | Fig. 1c: a nonconvex billiard with inward-curving walls |
 //! | [`DoublePendulum`] | `double_pendulum.yaml` | 2 | 2 | a double pendulum whose tip hits a wall and a floor |
 //! | [`Arm3`] | `arm3.yaml` | 3 | 1 | a three-link arm with a wall at its tip |
+//! | [`Chain2`] .. [`Chain12`] | `chains/chainNN.yaml` | N | N | planar N-link chains (unit masses, one floor gap per mass), written by `chains/gen.py`, for scaling benchmarks |
 //!
 //! ```
 //! use moreau::Model;
@@ -26,3 +27,14 @@ moreau::model!(file = "three_balls.yaml");
 moreau::model!(file = "billiard.yaml");
 moreau::model!(file = "double_pendulum.yaml");
 moreau::model!(file = "arm3.yaml");
+moreau::model!(file = "chains/chain02.yaml");
+moreau::model!(file = "chains/chain03.yaml");
+moreau::model!(file = "chains/chain04.yaml");
+moreau::model!(file = "chains/chain05.yaml");
+moreau::model!(file = "chains/chain06.yaml");
+moreau::model!(file = "chains/chain07.yaml");
+moreau::model!(file = "chains/chain08.yaml");
+moreau::model!(file = "chains/chain09.yaml");
+moreau::model!(file = "chains/chain10.yaml");
+moreau::model!(file = "chains/chain11.yaml");
+moreau::model!(file = "chains/chain12.yaml");

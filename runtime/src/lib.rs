@@ -11,6 +11,7 @@
 
 mod enclosure;
 mod error;
+mod interval;
 mod lcp;
 mod linalg;
 mod model;
@@ -23,8 +24,15 @@ mod validate;
 
 pub use enclosure::{Enclose, Enclosure};
 pub use error::DataError;
+pub use interval::{Interval, LIBM_ULPS, next_down, next_up};
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Sensitivities, Structure, Terms};
+pub use observer::{
+    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+};
+#[cfg(feature = "std")]
+pub use observer::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};
 pub use observer::{
     Design, Discretization, FullOrder, FullOrderGains, GainRegion, ModelBounds, Observer,
     ObserverError, ObserverParams, ReducedOrder, Restart, UpdateReport,

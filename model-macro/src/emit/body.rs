@@ -12,7 +12,8 @@
 use moreau_sym::{Func, Layout, Op, Operand, Schedule, VarId};
 
 use super::names::{Local, Names, Role};
-use crate::resolve::{Resolved, Var, VarLayout};
+use crate::resolve::{Resolved, VarLayout};
+use crate::scope::Var;
 
 /// The deepest an expression of the generated code may nest before its
 /// parts are bound to names.

@@ -34,7 +34,8 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use crate::lower::Lowered;
-use crate::resolve::{Resolved, Var};
+use crate::resolve::Resolved;
+use crate::scope::Var;
 use body::Body;
 use print::{Scalar, Text, Tokens};
 

@@ -16,7 +16,8 @@ use std::collections::{HashMap, HashSet};
 use moreau_sym::{Func, Slot};
 
 use crate::expr::fmt_number;
-use crate::resolve::{Resolved, Var};
+use crate::resolve::Resolved;
+use crate::scope::Var;
 
 /// A binding of a generated method body.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -15,7 +15,8 @@ use quote::{ToTokens, quote};
 use super::body::{Body, Code, Let};
 use super::names::{Local, Names};
 use crate::expr::fmt_number;
-use crate::resolve::{Resolved, Var};
+use crate::resolve::Resolved;
+use crate::scope::Var;
 
 /// Where printed code goes.
 pub(crate) trait Sink {

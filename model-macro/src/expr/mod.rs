@@ -72,7 +72,7 @@ impl BinOp {
 
 /// An expression of the model language, every node with its location.
 /// `N` is what a name is: its text after the front ends, a typed
-/// [`Symbol`](crate::resolve::Symbol) after resolution.
+/// `Symbol` (`scope.rs`) after resolution.
 #[derive(Clone, Debug)]
 pub(crate) struct Expr<N = String> {
     pub kind: ExprKind<N>,

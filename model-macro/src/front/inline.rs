@@ -74,6 +74,7 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         gravity: None,
         bodies_loc: None,
         origin: Origin::Inline,
+        unreadable: Vec::new(),
     };
     let mut seen: Vec<String> = Vec::new();
     let mut rest = &trees[header_end..];
@@ -144,8 +145,10 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
     let key_text = key.to_string();
     let loc = Loc::span(key.span());
     if key_text == "let" {
-        if let Some(definition) = definition(cx, &item[1..], loc) {
-            spec.definitions.push(definition);
+        match definition(cx, &item[1..], loc) {
+            Ok(definition) => spec.definitions.push(definition),
+            Err(Some(name)) => spec.unreadable.push(name),
+            Err(None) => {}
         }
         return;
     }
@@ -453,18 +456,23 @@ fn assigned_expr(cx: &Ctxt, rest: &[TokenTree], loc: Loc, key: &str) -> Option<E
     }
 }
 
-fn definition(cx: &Ctxt, rest: &[TokenTree], loc: Loc) -> Option<Definition> {
+/// `let name = expr;`; the name alone when the expression could not be
+/// read (after reporting why).
+fn definition(cx: &Ctxt, rest: &[TokenTree], loc: Loc) -> Result<Definition, Option<Name>> {
     match rest {
-        [TokenTree::Ident(name), eq, value @ ..] if is_punct(eq, '=') => Some(Definition {
-            name: Name {
+        [TokenTree::Ident(name), eq, value @ ..] if is_punct(eq, '=') => {
+            let name = Name {
                 text: name.to_string(),
                 loc: Loc::span(name.span()),
-            },
-            expr: expression(cx, value, Loc::span(eq.span()))?,
-        }),
+            };
+            match expression(cx, value, Loc::span(eq.span())) {
+                Some(expr) => Ok(Definition { name, expr }),
+                None => Err(Some(name)),
+            }
+        }
         _ => {
             cx.error(loc, "expected `let name = <expression>;`");
-            None
+            Err(None)
         }
     }
 }

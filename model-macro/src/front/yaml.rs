@@ -147,6 +147,7 @@ pub(crate) fn build(
             text,
             reads: Vec::new(),
         },
+        unreadable: Vec::new(),
     };
     let mut seen: Vec<&str> = Vec::new();
     let (mut urdf, mut locked): (Option<(Name, &YNode)>, Vec<Name>) = (None, Vec::new());
@@ -322,16 +323,12 @@ impl Walker<'_> {
                 _ => w.expected(value, "a list of input names, like `[u1, u2]`"),
             },
             keys::DEFINITIONS => {
-                spec.definitions = w
-                    .entries(value, keys::DEFINITIONS)
-                    .into_iter()
-                    .filter_map(|(name, v)| {
-                        Some(Definition {
-                            name,
-                            expr: w.expr(v)?,
-                        })
-                    })
-                    .collect();
+                for (name, v) in w.entries(value, keys::DEFINITIONS) {
+                    match w.expr(v) {
+                        Some(expr) => spec.definitions.push(Definition { name, expr }),
+                        None => spec.unreadable.push(name),
+                    }
+                }
             }
             keys::KINETIC => spec.kinetic = w.expr(value),
             keys::POTENTIAL => spec.potential = w.expr(value),

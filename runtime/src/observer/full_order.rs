@@ -3,10 +3,10 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::Lcp;
-use crate::linalg::SymmetricEigen;
+use crate::linalg::{Cholesky, SymmetricEigen};
 use crate::model::Model;
 
-use super::interval::{Interval, Memory, saturate};
+use super::interval::{Cache, Interval, Memory, saturate};
 use super::reduced_order::{restart_velocity, section_vii_impact};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
@@ -120,6 +120,48 @@ pub struct FullOrder<T: RealField + Copy, const N: usize, const K: usize> {
     report: UpdateReport<T, N, K>,
     /// The outliers refused since the last accepted measurement.
     outliers: Outliers<T, N>,
+    /// Memos of the injection gain and of a constant `M`'s factor.
+    cache: Cache<T, N>,
+    /// Memo of the error flow of the last `(τ, M⁻¹ L_ρ1)`.
+    flow: FlowMemo<T, N>,
+}
+
+/// The error flow [`error_flow`] of the last `(τ, M⁻¹ L_ρ1)` for a model
+/// whose `M` is constant (`Λ` and `l_d` are fixed per observer): a pure
+/// memo, so a hit returns the bits a recomputation would.
+#[derive(Clone, Copy, Debug)]
+struct FlowMemo<T: RealField + Copy, const N: usize> {
+    last: Option<Flow<T, N>>,
+}
+
+/// One memoized error flow: its key `(τ, M⁻¹ L_ρ1)` and its value.
+type Flow<T, const N: usize> = (T, SMatrix<T, N, N>, ErrorFlow<T, N>);
+
+/// `exp(τA)` of the error system in `N × N` blocks.
+type ErrorFlow<T, const N: usize> = [[SMatrix<T, N, N>; 2]; 2];
+
+impl<T: RealField + Copy, const N: usize> FlowMemo<T, N> {
+    const EMPTY: Self = Self { last: None };
+
+    /// `error_flow(τ, Λ, l_d, M⁻¹ L_ρ1)`, recomputed only for a new key.
+    fn get(
+        &mut self,
+        tau: T,
+        chol: &Cholesky<T, N>,
+        gains: &FullOrderGains<T, N>,
+        l_d: T,
+    ) -> ErrorFlow<T, N> {
+        let stiffness = chol.solve(&gains.l_rho1);
+        if let Some((key_tau, key, flow)) = self.last
+            && key_tau == tau
+            && key == stiffness
+        {
+            return flow;
+        }
+        let flow = error_flow(tau, &gains.lambda, l_d, &stiffness);
+        self.last = Some((tau, stiffness, flow));
+        flow
+    }
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
@@ -156,6 +198,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
             v: v0,
             report: UpdateReport::new(t0, T::zero()),
             outliers: Outliers::NONE,
+            cache: Cache::default(),
+            flow: FlowMemo::EMPTY,
         })
     }
 
@@ -211,6 +255,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     fn impact_aware<M>(
         &self,
         interval: &Interval<'_, M, T, N, K>,
+        memo: Option<ErrorFlow<T, N>>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, N>), ObserverError<T>>
     where
@@ -226,10 +271,15 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         let v_tilde = innovation / tau;
         // their flow under q̃' = ṽ − Λq̃, ṽ' = −M⁻¹L_ρ1 q̃ − l_d ṽ, with M at
         // q_{k+1}
-        let mass = interval.model.mass(&interval.q1);
-        let chol = factor_mass(&mass)?;
-        let stiffness = chol.solve(&self.gains.l_rho1);
-        let flow = error_flow(tau, &self.gains.lambda, self.params.l_d, &stiffness);
+        let flow = match memo {
+            Some(flow) => flow,
+            None => {
+                let mass = interval.model.mass(&interval.q1);
+                let chol = factor_mass(&mass)?;
+                let stiffness = chol.solve(&self.gains.l_rho1);
+                error_flow(tau, &self.gains.lambda, self.params.l_d, &stiffness)
+            }
+        };
         let q_tilde_next = flow[0][0] * q_tilde + flow[0][1] * v_tilde;
         let v_tilde_next = flow[1][0] * q_tilde + flow[1][1] * v_tilde;
         // the prediction carried ṽ_k unchanged: v_{k+1} = w(τ) + ṽ_k
@@ -264,7 +314,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         );
         report.evaluations += 1;
         finite_model(&forces, "F")?;
-        let chol = factor_mass(&mass)?;
+        let chol = match interval.mass {
+            Some(chol) => chol,
+            None => factor_mass(&mass)?,
+        };
         let f2 = forces - (self.gains.l_rho1 + mass * lambda * l_d) * q_tilde;
         let z2_free = z2 - chol.solve(&f2) * tau;
         let v_free = z2_free + (q1 - z1_next) * l_d;
@@ -281,13 +334,14 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
     fn integrate<M>(
         &self,
         interval: &Interval<'_, M, T, N, K>,
+        memo: Option<ErrorFlow<T, N>>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, N>), Restart>
     where
         M: Model<N, K, Scalar = T>,
     {
         let result = match self.params.scheme {
-            Discretization::ImpactAware => self.impact_aware(interval, report),
+            Discretization::ImpactAware => self.impact_aware(interval, memo, report),
             Discretization::SectionVii => self.section_vii(interval, report),
         };
         match result {
@@ -392,14 +446,26 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for 
             restitution: self.restitution,
             report: &self.report,
         };
-        let (interval, fresh) = Interval::begin(model, u, memory, t, q)?;
+        let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN: an outlier is refused here, the estimate untouched
         let plan = self
             .outliers
             .screen(&self.params, (t, interval.tau), &self.q, q)?;
         let mut report = fresh;
         let integrated = match plan {
-            Plan::Integrate => self.integrate(&interval, &mut report),
+            Plan::Integrate => {
+                // a constant M: its error flow depends on τ alone
+                let memo = match (self.params.scheme, interval.mass) {
+                    (Discretization::ImpactAware, Some(chol)) => {
+                        Some(
+                            self.flow
+                                .get(interval.tau, &chol, &self.gains, self.params.l_d),
+                        )
+                    }
+                    _ => None,
+                };
+                self.integrate(&interval, memo, &mut report)
+            }
             Plan::Restart(why) => Err(why),
         };
         let (q_hat, v) = match integrated {

@@ -16,6 +16,9 @@ use crate::validate::{self, factor_mass, finite_model as finite};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
+mod traced;
+pub(crate) use traced::{Flight, Jump, Tracer};
+
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
 /// the ball `|v| ≤ C_v`, 1-Lipschitz, so `F̄(t, q, v) = F(t, q, sat(v))` is
 /// the Lipschitz extension of Assumption 1.
@@ -31,6 +34,88 @@ pub(crate) fn saturate<T: RealField + Copy, const N: usize>(
 /// `ṽ' = −l_d ṽ` exactly over an interval of length `τ` (`→ l_d` as `τ → 0`).
 pub(crate) fn injection_gain<T: RealField + Copy>(l_d: T, tau: T) -> T {
     -(-(l_d * tau)).exp_m1() / tau
+}
+
+/// `h > |r| b` shown without the square root of `|r|`: `true` only when it
+/// holds with a margin of two (`h² > 4 |r|² b²`), far beyond rounding, so
+/// that `false` leaves the exact test `h ≤ |r| b` to the caller. Sound for
+/// every finite input (an overflowing `h²` is a gap far open; an
+/// underflowing one fails this test and goes to the exact one).
+fn clearly_open<T: RealField + Copy>(h: T, row_norm_squared: T, band: T) -> bool {
+    let four: T = nalgebra::convert(4.0);
+    h > T::zero() && h * h > four * row_norm_squared * band * band
+}
+
+/// What an observer remembers only to skip work: pure memos of functions
+/// of their keys, so that a hit returns the very bits a recomputation
+/// would (an observer's value, and its `==`, ignore them).
+///
+/// * the injection gain [`injection_gain`]`(l_d, τ)` of the last four
+///   distinct `τ` (on a grid `t_k = kτ`, `t_{k+1} − t_k` takes a handful of
+///   values a few ulps apart, and `l_d` is fixed per observer);
+/// * for a model whose `M` the compiler proved constant
+///   ([`Structure::mass_constant`](crate::Structure::mass_constant)), `M`
+///   and its Cholesky factor, reused while `M` evaluates to the same bits
+///   (a parameter changed through `parameter_mut` gives another `M`, and a
+///   new factorization).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cache<T: RealField + Copy, const N: usize> {
+    gains: [(T, T); 4],
+    next: usize,
+    mass: Option<(SMatrix<T, N, N>, Cholesky<T, N>)>,
+}
+
+impl<T: RealField + Copy, const N: usize> Default for Cache<T, N> {
+    fn default() -> Self {
+        Self {
+            // τ = 0 is never a key: an update's τ is positive
+            gains: [(T::zero(), T::zero()); 4],
+            next: 0,
+            mass: None,
+        }
+    }
+}
+
+impl<T: RealField + Copy, const N: usize> PartialEq for Cache<T, N> {
+    /// Memos are not part of an observer's value.
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl<T: RealField + Copy, const N: usize> Cache<T, N> {
+    /// [`injection_gain`]`(l_d, τ)`, recomputed only for a new `τ`.
+    fn gain(&mut self, l_d: T, tau: T) -> T {
+        if let Some(&(_, gain)) = self.gains.iter().find(|(key, _)| *key == tau) {
+            return gain;
+        }
+        let gain = injection_gain(l_d, tau);
+        self.gains[self.next] = (tau, gain);
+        self.next = (self.next + 1) % self.gains.len();
+        gain
+    }
+
+    /// For a model with a constant `M`, its factor: from the memo when `M`
+    /// is unchanged, else factored now. `None` (the caller factors `M` where
+    /// it evaluates it, and reports a failure there) for any other model or
+    /// when `M` does not factor.
+    fn mass<M, const K: usize>(&mut self, model: &M, q: &SVector<T, N>) -> Option<Cholesky<T, N>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        if !M::STRUCTURE.mass_constant {
+            return None;
+        }
+        let mass = model.mass(q);
+        match self.mass {
+            Some((key, chol)) if key == mass => Some(chol),
+            _ => {
+                let chol = factor_mass(&mass).ok()?;
+                self.mass = Some((mass, chol));
+                Some(chol)
+            }
+        }
+    }
 }
 
 /// The mass matrix factored and the free acceleration `−M⁻¹ F̄` at one
@@ -157,6 +242,9 @@ where
     /// the first update). A closed constraint approaching slower than that
     /// cannot be told from a resting one.
     pub uncertainty: T,
+    /// The factor of `M` when the model's `M` is constant (the same at
+    /// every point of the interval): one factorization, or none, per update.
+    pub mass: Option<Cholesky<T, N>>,
 }
 
 /// What an observer remembers between updates, as the interval needs it.
@@ -179,18 +267,20 @@ where
 {
     /// Checks one update's data (the measurement `q` at `t`, the input
     /// `u`, the model's parameters and restitution) and opens the interval
-    /// `[t_k, t]` with an empty report.
+    /// `[t_k, t]` with an empty report; `cache` holds the observer's memos.
     pub fn begin(
         model: &'a M,
         u: &'a M::Input,
         memory: Memory<'a, T, N, K>,
+        cache: &mut Cache<T, N>,
         t: T,
         q: &SVector<T, N>,
     ) -> Result<(Self, UpdateReport<T, N, K>), T> {
         let tau = check_update(model, memory.t, t, q, u)?;
         let restitution = memory.restitution.unwrap_or_else(|| model.restitution());
         validate::restitution(&restitution)?;
-        let gain = injection_gain(memory.params.l_d, tau);
+        let gain = cache.gain(memory.params.l_d, tau);
+        let mass = cache.mass::<M, K>(model, &memory.q);
         let interval = Interval {
             model,
             u,
@@ -203,6 +293,7 @@ where
             restitution,
             uncertainty: memory.report.uncertainty(),
             gain,
+            mass,
         };
         let mut report = UpdateReport::new(t, tau);
         report.gain = gain;
@@ -287,12 +378,28 @@ where
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Free<T, N>, T> {
         let w_bar = saturate(w, self.params.velocity_bound);
-        let (mass, forces) = self.model.dynamics(self.t0 + s, p, &w_bar, self.u);
+        let (chol, forces) = self.dynamics(self.t0 + s, p, &w_bar)?;
         report.evaluations += 1;
-        finite(&forces, "F")?;
-        let chol = factor_mass(&mass)?;
         let accel = -chol.solve(&forces);
         Ok(Free { chol, accel })
+    }
+
+    /// `M(p)` factored and `F(t, p, w)`, checked: `M` from the interval's
+    /// factor when it is constant, evaluated with `F` otherwise.
+    pub fn dynamics(
+        &self,
+        t: T,
+        p: &SVector<T, N>,
+        w: &SVector<T, N>,
+    ) -> Result<(Cholesky<T, N>, SVector<T, N>), T> {
+        if let Some(chol) = self.mass {
+            let forces = self.model.forces(t, p, w, self.u);
+            finite(&forces, "F")?;
+            return Ok((chol, forces));
+        }
+        let (mass, forces) = self.model.dynamics(t, p, w, self.u);
+        finite(&forces, "F")?;
+        Ok((factor_mass(&mass)?, forces))
     }
 
     /// `(h(p), J(p))`, checked.
@@ -370,6 +477,22 @@ where
         } = *start;
         let half = h * nalgebra::convert::<f64, T>(0.5);
         let two: T = nalgebra::convert(2.0);
+        let sixth = h / nalgebra::convert(6.0);
+        if sliding.is_empty() {
+            // free flight: the free accelerations, no contact force
+            let k1 = first.accel;
+            let (p2, w2) = (p0 + w0 * half, w0 + k1 * half);
+            let k2 = self.free(s0 + half, &p2, &w2, report)?.accel;
+            let (p3, w3) = (p0 + w2 * half, w0 + k2 * half);
+            let k3 = self.free(s0 + half, &p3, &w3, report)?.accel;
+            let (p4, w4) = (p0 + w3 * h, w0 + k3 * h);
+            let k4 = self.free(s0 + h, &p4, &w4, report)?.accel;
+            return Ok(Arc {
+                p: p0 + (w0 + w2 * two + w3 * two + w4) * sixth,
+                w: w0 + (k1 + k2 * two + k3 * two + k4) * sixth,
+                impulse: SVector::zeros(),
+            });
+        }
         let (k1, l1) = self.constrained(p0, w0, sliding, first, report)?;
         let (p2, w2) = (p0 + w0 * half, w0 + k1 * half);
         let f2 = self.free(s0 + half, &p2, &w2, report)?;
@@ -380,7 +503,6 @@ where
         let (p4, w4) = (p0 + w3 * h, w0 + k3 * h);
         let f4 = self.free(s0 + h, &p4, &w4, report)?;
         let (k4, l4) = self.constrained(&p4, &w4, sliding, &f4, report)?;
-        let sixth = h / nalgebra::convert(6.0);
         Ok(Arc {
             p: p0 + (w0 + w2 * two + w3 * two + w4) * sixth,
             w: w0 + (k1 + k2 * two + k3 * two + k4) * sixth,
@@ -433,7 +555,12 @@ where
         let four: T = nalgebra::convert(4.0);
         let mut closed = IndexSet::<K>::EMPTY;
         for i in 0..K {
-            let g = jac.row(i).norm();
+            let row = jac.row(i);
+            if !touched.contains(i) && clearly_open(h[i], row.norm_squared(), band) {
+                c.free.insert(i);
+                continue;
+            }
+            let g = row.norm();
             if h[i] <= g * band || touched.contains(i) {
                 closed.insert(i);
             } else {
@@ -551,13 +678,13 @@ where
 
     /// The first constraint to close along the segment (see the module
     /// docs: an open gap that ends closed, an open gap that dips below zero
-    /// and reopens, a separating contact that comes back; `bands` are the
-    /// contact bands `g_i b` at the segment's start).
+    /// and reopens, a separating contact that comes back; the contact band of
+    /// constraint `i` at the segment's start is `|J_i| b`, from `(J, b)`).
     fn first_crossing(
         &self,
         seg: &Segment<T, N>,
         c: &Classes<K>,
-        bands: &SVector<T, K>,
+        (jac, band): (&SMatrix<T, K, N>, T),
         start: (&SVector<T, K>, &SVector<T, K>),
         end: (&SVector<T, K>, &SVector<T, K>),
     ) -> Result<Option<Crossing<T, K>>, T> {
@@ -594,7 +721,7 @@ where
                 // turning point (normal speed zero) it is a persistent
                 // contact
                 let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
-                if fm > bands[i] {
+                if fm > jac.row(i).norm() * band {
                     record(self.root(seg, i, [(m, fm), (seg.h, h1[i])])?, i);
                 } else {
                     record(m, i);
@@ -612,80 +739,7 @@ where
         v0: &SVector<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, N>), T> {
-        let max_impacts = self.params.max_impacts;
-        let max_rounds = max_impacts.saturating_mul(2).saturating_add(8);
-        let (mut s, mut p, mut w) = (T::zero(), self.q0, *v0);
-        // constraints that met Newton's law at this point (no second law
-        // here), and reached by a root at this point (closed whatever the
-        // sign of their gap)
-        let mut resolved = IndexSet::EMPTY;
-        let mut touched = IndexSet::EMPTY;
-        let mut round = 0;
-        loop {
-            round += 1;
-            let last_round = round >= max_rounds;
-            // CLASSIFY at (s, p, w)
-            let free = self.free(s, &p, &w, report)?;
-            let (h, jac) = self.contact(&p)?;
-            let point = Point {
-                s,
-                p: &p,
-                w: &w,
-                free: &free,
-            };
-            let c = self.classify(&point, (&h, &jac), resolved, touched)?;
-            // IMPACT now, on the closed constraints met approaching
-            if !c.approaching.is_empty() && !last_round {
-                let elastic = if report.impacts < max_impacts {
-                    c.elastic
-                } else {
-                    IndexSet::EMPTY
-                };
-                let at = Contact {
-                    s,
-                    w: &w,
-                    jac: &jac,
-                    chol: &free.chol,
-                };
-                w = self.newton(&at, c.contact, elastic, report)?;
-                resolved = resolved.union(c.approaching);
-                touched = touched.union(c.approaching);
-                continue;
-            }
-            // FLIGHT (and sliding) to the end of the interval
-            let rest = self.tau - s;
-            if rest <= T::zero() {
-                return Ok((p, w));
-            }
-            let arc = self.rk4(&point, rest, c.sliding, report)?;
-            report.contacts = report.contacts.union(c.sliding);
-            // SEARCH for the first closing constraint along it
-            if !last_round && report.impacts < max_impacts {
-                let (h1, jac1) = self.contact(&arc.p)?;
-                let seg = Segment {
-                    p0: p,
-                    w0: w,
-                    p1: arc.p,
-                    w1: arc.w,
-                    h: rest,
-                };
-                let rate0 = jac * w;
-                let rate1 = jac1 * arc.w;
-                let band = self.params.contact_band();
-                let bands = SVector::<T, K>::from_fn(|i, _| jac.row(i).norm() * band);
-                if let Some(Crossing { at, set }) =
-                    self.first_crossing(&seg, &c, &bands, (&h, &rate0), (&h1, &rate1))?
-                {
-                    let part = self.rk4(&point, at, c.sliding, report)?;
-                    report.impulses += part.impulse;
-                    (s, p, w) = (s + at, part.p, part.w);
-                    (resolved, touched) = (IndexSet::EMPTY, set);
-                    continue;
-                }
-            }
-            report.impulses += arc.impulse;
-            return Ok((arc.p, arc.w));
-        }
+        self.predict_traced(v0, report, &mut traced::NoTrace)
     }
 
     /// Newton's law at the end of the interval, at the measured `q_{k+1}`,
@@ -698,10 +752,20 @@ where
     ) -> Result<SVector<T, N>, T> {
         let (h, jac) = self.contact(&self.q1)?;
         let band = self.params.contact_band();
-        let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * v.norm();
+        let scale = T::default_epsilon() * nalgebra::convert(64.0);
+        // the cheap tests first: a constraint the estimate does not
+        // approach (`J_i v ≥ 0`), or a gap clearly open, needs no norm
         let approaching = (0..K).any(|i| {
             let row = jac.row(i);
-            h[i] <= row.norm() * band && row.dot(&v.transpose()) < -roundoff * row.norm()
+            let jv = row.dot(&v.transpose());
+            // (`jv ≥ 0` or NaN: not approaching)
+            if jv.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Less)
+                || clearly_open(h[i], row.norm_squared(), band)
+            {
+                return false;
+            }
+            let g = row.norm();
+            h[i] <= g * band && jv < -(scale * v.norm()) * g
         });
         if !approaching {
             return Ok(*v);

@@ -282,13 +282,20 @@ mod error;
 mod full_order;
 mod gains;
 mod interval;
+mod kalman;
 mod params;
 mod reduced_order;
 mod report;
 
 pub use error::ObserverError;
 pub use full_order::{FullOrder, FullOrderGains};
+#[cfg(feature = "std")]
+pub use gains::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};
 pub use gains::{Design, GainRegion, ModelBounds};
+pub use kalman::{
+    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+};
 pub use params::{Discretization, ObserverParams};
 pub use reduced_order::ReducedOrder;
 pub use report::{Restart, UpdateReport};

@@ -6,7 +6,7 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Interval, Memory, saturate};
+use super::interval::{Cache, Interval, Memory, saturate};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
     UpdateReport, check_start,
@@ -77,6 +77,8 @@ pub struct ReducedOrder<T: RealField + Copy, const N: usize, const K: usize> {
     report: UpdateReport<T, N, K>,
     /// The outliers refused since the last accepted measurement.
     outliers: Outliers<T, N>,
+    /// Memos of the injection gain and of a constant `M`'s factor.
+    cache: Cache<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
@@ -105,6 +107,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
             v: v0,
             report: UpdateReport::new(t0, T::zero()),
             outliers: Outliers::NONE,
+            cache: Cache::default(),
         })
     }
 
@@ -155,7 +158,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         );
         report.evaluations += 1;
         finite_model(&forces, "F")?;
-        let chol = factor_mass(&mass)?;
+        let chol = match interval.mass {
+            Some(chol) => chol,
+            None => factor_mass(&mass)?,
+        };
         let v_free = v_pre - chol.solve(&forces) * tau - v_pre * (tau * l_d);
         report.innovation = q1 - self.q - self.v * tau;
         section_vii_impact(interval, &chol, &self.v, &v_free, report)
@@ -304,7 +310,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
             restitution: self.restitution,
             report: &self.report,
         };
-        let (interval, fresh) = Interval::begin(model, u, memory, t, q)?;
+        let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN: an outlier is refused here, the estimate untouched
         let plan = self
             .outliers

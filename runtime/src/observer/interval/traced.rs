@@ -1,0 +1,189 @@
+//! The predicted motion of one interval, told piece by piece to a
+//! [`Tracer`]: what an estimator that carries more than an estimate (the
+//! saltation Kalman filter's covariance) needs from the interval.
+//!
+//! [`Interval::predict_traced`] is the one loop of the predicted motion:
+//! [`Interval::predict`] runs it with a tracer that does nothing, so the
+//! observers and the filter make the same decisions (classification, root
+//! search, Newton's law, sliding) in the same order, with the same bits.
+
+use nalgebra::{RealField, SVector};
+
+use crate::lcp::IndexSet;
+use crate::model::Model;
+
+use super::{Contact, Crossing, Interval, Point, Result, Segment, UpdateReport};
+
+/// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
+/// length `h`, with the persistent contacts `sliding` held at acceleration
+/// level (`impulse` their `∫ λ ds`), ending at `(p1, w1)`.
+pub(crate) struct Flight<'a, T: RealField + Copy, const N: usize, const K: usize> {
+    pub s0: T,
+    pub h: T,
+    pub p0: &'a SVector<T, N>,
+    pub w0: &'a SVector<T, N>,
+    pub p1: &'a SVector<T, N>,
+    pub w1: &'a SVector<T, N>,
+    pub sliding: IndexSet<K>,
+    pub impulse: &'a SVector<T, K>,
+}
+
+/// One application of Newton's law at local time `s`, configuration `p`:
+/// the law took `w⁻` with the impulses `lambda` on the constraints of `set`
+/// (`ê` on `elastic`, `0` on the rest); `guard` holds the constraints whose
+/// root along the motion was located here (empty when the law met a
+/// closed constraint at the start of a piece).
+pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> {
+    pub s: T,
+    pub p: &'a SVector<T, N>,
+    pub w_minus: &'a SVector<T, N>,
+    pub lambda: &'a SVector<T, K>,
+    pub set: IndexSet<K>,
+    pub elastic: IndexSet<K>,
+    pub guard: IndexSet<K>,
+    pub restitution: &'a SVector<T, K>,
+}
+
+/// What follows the predicted motion of an interval, piece by piece.
+pub(crate) trait Tracer<T: RealField + Copy, const N: usize, const K: usize> {
+    /// A piece of flight (or sliding) was integrated.
+    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T>;
+    /// Newton's law was applied.
+    fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T>;
+}
+
+/// The tracer of the observers, which carry nothing beyond the estimate.
+pub(crate) struct NoTrace;
+
+impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for NoTrace {
+    #[inline(always)]
+    fn flight(&mut self, _: &Flight<'_, T, N, K>) -> Result<(), T> {
+        Ok(())
+    }
+    #[inline(always)]
+    fn jump(&mut self, _: &Jump<'_, T, N, K>) -> Result<(), T> {
+        Ok(())
+    }
+}
+
+impl<M, T, const N: usize, const K: usize> Interval<'_, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    /// [`predict`](Interval::predict), reporting every piece of flight and
+    /// every impact to `tracer` as it happens.
+    pub(crate) fn predict_traced<R: Tracer<T, N, K>>(
+        &self,
+        v0: &SVector<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+        tracer: &mut R,
+    ) -> Result<(SVector<T, N>, SVector<T, N>), T> {
+        let max_impacts = self.params.max_impacts;
+        let max_rounds = max_impacts.saturating_mul(2).saturating_add(8);
+        let (mut s, mut p, mut w) = (T::zero(), self.q0, *v0);
+        // constraints that met Newton's law at this point (no second law
+        // here), and reached by a root at this point (closed whatever the
+        // sign of their gap)
+        let mut resolved = IndexSet::EMPTY;
+        let mut touched = IndexSet::EMPTY;
+        let mut round = 0;
+        loop {
+            round += 1;
+            let last_round = round >= max_rounds;
+            // CLASSIFY at (s, p, w)
+            let free = self.free(s, &p, &w, report)?;
+            let (h, jac) = self.contact(&p)?;
+            let point = Point {
+                s,
+                p: &p,
+                w: &w,
+                free: &free,
+            };
+            let c = self.classify(&point, (&h, &jac), resolved, touched)?;
+            // IMPACT now, on the closed constraints met approaching
+            if !c.approaching.is_empty() && !last_round {
+                let elastic = if report.impacts < max_impacts {
+                    c.elastic
+                } else {
+                    IndexSet::EMPTY
+                };
+                let before = report.impulses;
+                let at = Contact {
+                    s,
+                    w: &w,
+                    jac: &jac,
+                    chol: &free.chol,
+                };
+                let w_plus = self.newton(&at, c.contact, elastic, report)?;
+                let lambda = report.impulses - before;
+                tracer.jump(&Jump {
+                    s,
+                    p: &p,
+                    w_minus: &w,
+                    lambda: &lambda,
+                    set: c.contact,
+                    elastic,
+                    guard: touched.intersection(c.approaching),
+                    restitution: &self.restitution,
+                })?;
+                w = w_plus;
+                resolved = resolved.union(c.approaching);
+                touched = touched.union(c.approaching);
+                continue;
+            }
+            // FLIGHT (and sliding) to the end of the interval
+            let rest = self.tau - s;
+            if rest <= T::zero() {
+                return Ok((p, w));
+            }
+            let arc = self.rk4(&point, rest, c.sliding, report)?;
+            report.contacts = report.contacts.union(c.sliding);
+            // SEARCH for the first closing constraint along it
+            if !last_round && report.impacts < max_impacts {
+                let (h1, jac1) = self.contact(&arc.p)?;
+                let seg = Segment {
+                    p0: p,
+                    w0: w,
+                    p1: arc.p,
+                    w1: arc.w,
+                    h: rest,
+                };
+                let rate0 = jac * w;
+                let rate1 = jac1 * arc.w;
+                let band = self.params.contact_band();
+                if let Some(Crossing { at, set }) =
+                    self.first_crossing(&seg, &c, (&jac, band), (&h, &rate0), (&h1, &rate1))?
+                {
+                    let part = self.rk4(&point, at, c.sliding, report)?;
+                    tracer.flight(&Flight {
+                        s0: s,
+                        h: at,
+                        p0: &p,
+                        w0: &w,
+                        p1: &part.p,
+                        w1: &part.w,
+                        sliding: c.sliding,
+                        impulse: &part.impulse,
+                    })?;
+                    report.impulses += part.impulse;
+                    (s, p, w) = (s + at, part.p, part.w);
+                    (resolved, touched) = (IndexSet::EMPTY, set);
+                    continue;
+                }
+            }
+            tracer.flight(&Flight {
+                s0: s,
+                h: rest,
+                p0: &p,
+                w0: &w,
+                p1: &arc.p,
+                w1: &arc.w,
+                sliding: c.sliding,
+                impulse: &arc.impulse,
+            })?;
+            report.impulses += arc.impulse;
+            return Ok((arc.p, arc.w));
+        }
+    }
+}

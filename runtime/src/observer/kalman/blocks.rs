@@ -1,0 +1,169 @@
+//! `2N × 2N` matrices over the state `(q, v)`, kept as their four `N × N`
+//! blocks (stable Rust has no `SMatrix<T, {2 * N}, {2 * N}>`).
+
+use nalgebra::{RealField, SMatrix};
+
+/// A `2N × 2N` matrix over the state `x = (q, v)`, as its four `N × N`
+/// blocks:
+///
+/// $$B = \begin{pmatrix} B_{qq} & B_{qv} \\ B_{vq} & B_{vv} \end{pmatrix}.$$
+///
+/// The estimator's covariance `P` (with `vq = qvᵀ`), the transition of one
+/// piece of flight `Φ` and the saltation matrix `Ξ` of an impact are all of
+/// this type.
+///
+/// ```
+/// use moreau_runtime::Blocks;
+/// use nalgebra::Matrix2;
+///
+/// // the flow of q' = v, v' = 0 over τ = 0.5
+/// let phi = Blocks { qq: Matrix2::identity(), qv: Matrix2::identity() * 0.5,
+///                    vq: Matrix2::zeros(), vv: Matrix2::identity() };
+/// assert_eq!(phi.entry(0, 2), 0.5);
+/// assert_eq!(phi.mul(&phi).entry(1, 3), 1.0);
+/// let p = Blocks::<f64, 2>::identity();
+/// assert_eq!(phi.congruence(&p).entry(0, 0), 1.25);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blocks<T: RealField + Copy, const N: usize> {
+    /// Rows of `q`, columns of `q`.
+    pub qq: SMatrix<T, N, N>,
+    /// Rows of `q`, columns of `v`.
+    pub qv: SMatrix<T, N, N>,
+    /// Rows of `v`, columns of `q`.
+    pub vq: SMatrix<T, N, N>,
+    /// Rows of `v`, columns of `v`.
+    pub vv: SMatrix<T, N, N>,
+}
+
+impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
+    /// The identity.
+    pub fn identity() -> Self {
+        Self {
+            qq: SMatrix::identity(),
+            qv: SMatrix::zeros(),
+            vq: SMatrix::zeros(),
+            vv: SMatrix::identity(),
+        }
+    }
+
+    /// The block-diagonal matrix `diag(qq, vv)`.
+    pub fn diagonal(qq: SMatrix<T, N, N>, vv: SMatrix<T, N, N>) -> Self {
+        Self {
+            qq,
+            qv: SMatrix::zeros(),
+            vq: SMatrix::zeros(),
+            vv,
+        }
+    }
+
+    /// Entry `(i, j)` of the `2N × 2N` matrix, `0 ≤ i, j < 2N` (`q` first);
+    /// `None` out of range.
+    pub fn get(&self, i: usize, j: usize) -> Option<T> {
+        if i >= 2 * N || j >= 2 * N {
+            return None;
+        }
+        let block = match (i < N, j < N) {
+            (true, true) => &self.qq,
+            (true, false) => &self.qv,
+            (false, true) => &self.vq,
+            (false, false) => &self.vv,
+        };
+        Some(block[(i % N, j % N)])
+    }
+
+    /// Entry `(i, j)`, zero out of range.
+    pub fn entry(&self, i: usize, j: usize) -> T {
+        self.get(i, j).unwrap_or_else(T::zero)
+    }
+
+    /// The product `self · other`.
+    #[must_use]
+    pub fn mul(&self, o: &Self) -> Self {
+        Self {
+            qq: self.qq * o.qq + self.qv * o.vq,
+            qv: self.qq * o.qv + self.qv * o.vv,
+            vq: self.vq * o.qq + self.vv * o.vq,
+            vv: self.vq * o.qv + self.vv * o.vv,
+        }
+    }
+
+    /// The transpose.
+    #[must_use]
+    pub fn transpose(&self) -> Self {
+        Self {
+            qq: self.qq.transpose(),
+            qv: self.vq.transpose(),
+            vq: self.qv.transpose(),
+            vv: self.vv.transpose(),
+        }
+    }
+
+    /// The sum `self + other`.
+    #[must_use]
+    pub fn add(&self, o: &Self) -> Self {
+        Self {
+            qq: self.qq + o.qq,
+            qv: self.qv + o.qv,
+            vq: self.vq + o.vq,
+            vv: self.vv + o.vv,
+        }
+    }
+
+    /// `self · p · selfᵀ` for a symmetric `p`, made exactly symmetric.
+    #[must_use]
+    pub fn congruence(&self, p: &Self) -> Self {
+        self.mul(p).mul(&self.transpose()).symmetrized()
+    }
+
+    /// `(B + Bᵀ)/2`: the diagonal blocks symmetric, `vq = qvᵀ` exactly.
+    #[must_use]
+    pub fn symmetrized(&self) -> Self {
+        let half: T = nalgebra::convert(0.5);
+        let off = (self.qv + self.vq.transpose()) * half;
+        Self {
+            qq: (self.qq + self.qq.transpose()) * half,
+            qv: off,
+            vq: off.transpose(),
+            vv: (self.vv + self.vv.transpose()) * half,
+        }
+    }
+
+    /// Whether every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        [&self.qq, &self.qv, &self.vq, &self.vv]
+            .iter()
+            .all(|m| m.iter().all(|x| x.is_finite()))
+    }
+
+    /// The trace.
+    pub fn trace(&self) -> T {
+        self.qq.trace() + self.vv.trace()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Matrix2;
+
+    #[test]
+    fn entries_follow_the_blocks_and_products_the_full_matrix() {
+        let b = Blocks {
+            qq: Matrix2::new(1.0, 2.0, 3.0, 4.0),
+            qv: Matrix2::new(5.0, 6.0, 7.0, 8.0),
+            vq: Matrix2::new(9.0, 10.0, 11.0, 12.0),
+            vv: Matrix2::new(13.0, 14.0, 15.0, 16.0),
+        };
+        assert_eq!(b.entry(1, 0), 3.0);
+        assert_eq!(b.entry(0, 3), 6.0);
+        assert_eq!(b.entry(2, 1), 10.0);
+        assert_eq!(b.entry(3, 3), 16.0);
+        assert_eq!(b.get(4, 0), None);
+        // the product against the full 4 × 4 product
+        let full = |b: &Blocks<f64, 2>| nalgebra::Matrix4::from_fn(|i, j| b.entry(i, j));
+        let c = b.transpose().add(&Blocks::identity());
+        assert_eq!(full(&b.mul(&c)), full(&b) * full(&c));
+        assert_eq!(full(&b.transpose()), full(&b).transpose());
+    }
+}

@@ -1,0 +1,745 @@
+//! The saltation Kalman filter generated from the model: a third estimator
+//! beside (36) and (38), sharing their interval machinery and carrying a
+//! covariance with the estimate.
+//!
+//! # One interval `[t_k, t_{k+1}]`
+//!
+//! 1. **Predict** the state `x = (q, v)` from the estimate `(q̂_k, v̂_k)`
+//!    through the observers' interval: fourth-order Runge–Kutta on the
+//!    model, every impact located inside the interval (Newton's law with
+//!    the LCP on the closed constraints), persistent contacts held at
+//!    acceleration level, under the same contact rule (module docs of
+//!    `runtime/src/observer/mod.rs`), whose noise band is the estimate's
+//!    own position uncertainty `√max P_qq,ii` (at most `σ`) and whose
+//!    velocity noise is `√max P_vv,ii`: the prediction starts from the
+//!    filtered `q̂_k`, not from a raw sample, so a bounce a few `σ` high
+//!    is told from sliding. The interval tells each piece of
+//!    motion and each impact as it happens, and the covariance follows:
+//!    - a piece of flight of length `h` from `x_0`:
+//!      `P ← Φ P Φᵀ + Q(h)`, `Φ` the [`transition`] of the Jacobian
+//!      [`flow_jacobian`] at `x_0` (Runge–Kutta on the variational
+//!      equation with `A` held at the start of the piece: exact when `A`
+//!      is constant, as for Example 1 in flight, and otherwise of the
+//!      accuracy of a Jacobian frozen over at most one sampling interval),
+//!      `Q(h)` white acceleration noise of density `diag(q_a²)` integrated
+//!      exactly for `q'' = w`: `[[h³/3, h²/2], [h²/2, h]] ⊗ diag(q_a²)`;
+//!    - an impact: `P ← Ξ P Ξᵀ`, `Ξ` the [`saltation`] matrix of Newton's
+//!      law on the constraints that end it with a positive impulse (the
+//!      LCP's outcome), `ê_i` where the law was elastic and `0` where
+//!      plastic, the impact time moved by the constraint whose root timed
+//!      it (none for a plastic closure or a law met at a closed constraint:
+//!      then `Ξ = DΔ`, the reset's Jacobian);
+//!    - a piece of persistent contact on the set `S` (the constraints whose
+//!      multiplier pushed along it): the Jacobian of the constrained flow
+//!      ([`constrained_flow_jacobian`]), `P ← Φ P Φᵀ + Q(h)`, then `P`
+//!      projected onto the tangent space of the contact manifold at the
+//!      end of the piece, `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
+//!      `J_S δq = 0` and `∂(J_S v)/∂q δq + J_S δv = 0`
+//!      ([`Sensitivities::jacobian_dq`]), in the metric of `M` (that of a
+//!      plastic impact): `P ← B P Bᵀ`, a congruence, so positive
+//!      semi-definite whatever the round-off; the predicted state is moved
+//!      onto the manifold in the same metric. The contact force cancels
+//!      the normal motion, modelled and unmodelled; what stays uncertain
+//!      across the contact (its compliance, the plant's own penetration)
+//!      is the noise's position and velocity variances, added
+//!      uncorrelated: `P` stays positive definite, and a penetration seen
+//!      in exact samples moves the position estimate, not the velocity.
+//! 2. **Gate** the innovation `y = q_{k+1} − p(τ)`, `S = P_qq + R`: a
+//!    normalised innovation squared `yᵀS⁻¹y` above
+//!    [`KalmanParams::gate`] marks the sample an outlier; it is reported
+//!    ([`KalmanReport::outlier`]) and skipped (the estimate is the
+//!    prediction). After [`KalmanParams::max_outliers`] consecutive
+//!    outliers the model, not the sample, is taken to be wrong: `P` is
+//!    inflated by `yᵀS⁻¹y / N` and the sample is used.
+//! 3. **Update** with `H = [I 0]`: `K = P Hᵀ S⁻¹`, `x ← x + K y` and the
+//!    Joseph form `P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ`, symmetrised.
+//!
+//! Nothing here is written by the user: the Jacobians come from the
+//! model's generated [`Model::linearization`](crate::Model::linearization) and [`Sensitivities`].
+
+mod blocks;
+mod saltation;
+mod tune;
+
+pub use blocks::Blocks;
+pub use saltation::{Saltation, constrained_flow_jacobian, flow_jacobian, saltation, transition};
+pub use tune::{Tuning, tune_process_noise};
+
+use nalgebra::{RealField, SMatrix, SVector};
+
+use crate::lcp::{IndexSet, Lcp};
+use crate::model::Sensitivities;
+
+use super::interval::{Cache, Flight, Interval, Jump, Memory, Tracer, saturate};
+use super::{Estimate, ObserverError, ObserverParams, UpdateReport};
+use crate::error::DataError;
+use crate::validate::{self, factor_mass};
+use saltation::project_onto_contact;
+
+type Result<X, T> = core::result::Result<X, ObserverError<T>>;
+
+/// Settings of the [`SaltationKalman`] filter.
+///
+/// One `Copy` struct of knobs, each with its default and what moving it
+/// does; [`KalmanParams::new`] takes the velocity bound and the
+/// measurement noise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KalmanParams<T: RealField + Copy, const N: usize> {
+    /// The interval's settings, shared with the observers: the velocity
+    /// bound `C_v` (forces at `sat(v̂)`), the measurement noise `σ` and
+    /// `noise_sigmas`, which set the contact band, the contact rule and
+    /// `max_impacts`. Its gain `l_d` is not used by the filter.
+    pub observer: ObserverParams<T>,
+    /// Process noise as acceleration noise per coordinate: the amplitude
+    /// spectral density `q_a,i` of a white acceleration on `q_i` (units of
+    /// `q` per s² per √Hz; the covariance it adds over `h` is
+    /// `[[h³/3, h²/2], [h²/2, h]] q_a,i²`). Default `1e-2` on every
+    /// coordinate: what the model leaves out (integration error, impact
+    /// timing, unmodelled forces) as a white acceleration of 0.01 m/s² in a
+    /// 1 Hz band; [`tune_process_noise`] picks it from a recorded run.
+    pub accel_noise: SVector<T, N>,
+    /// The measurement noise covariance `R` (symmetric positive
+    /// semi-definite; default `σ² I` from [`KalmanParams::new`]).
+    pub measurement: SMatrix<T, N, N>,
+    /// Innovation gate: a normalised innovation squared `yᵀS⁻¹y` above it
+    /// marks the sample an outlier (default: the χ² quantile with `N`
+    /// degrees of freedom four standard deviations out, probability
+    /// 3.2e-5 for a sample the model explains: 21.9 for `N = 2`, 24.5
+    /// for `N = 3`; Wilson–Hilferty). Infinity turns the gate off.
+    pub gate: T,
+    /// Consecutive outliers skipped before the filter takes the model to be
+    /// wrong and uses the sample with its covariance inflated (default `2`).
+    pub max_outliers: u32,
+    /// Standard deviation of the initial velocity estimate on each
+    /// coordinate (default `C_v`, the velocity bound: what the filter knows
+    /// of a velocity it has not seen).
+    pub initial_velocity_sigma: T,
+}
+
+/// `χ²_N` quantile `z` standard deviations out, by Wilson–Hilferty:
+/// `N (1 − 2/(9N) + z √(2/(9N)))³`.
+fn chi_square_quantile<T: RealField + Copy>(n: usize, z: T) -> T {
+    let n: T = nalgebra::convert(n.max(1) as f64);
+    let c = nalgebra::convert::<f64, T>(2.0 / 9.0) / n;
+    let base = T::one() - c + z * c.sqrt();
+    n * base * base * base
+}
+
+impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
+    /// Velocity bound `C_v`, measurement noise `σ` on each coordinate, and
+    /// the defaults.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanParams;
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4);
+    /// assert_eq!(p.measurement[(0, 0)], 1e-8);
+    /// assert!((p.gate - 21.9).abs() < 0.1);
+    /// ```
+    #[must_use]
+    pub fn new(velocity_bound: T, sigma: T) -> Self {
+        Self {
+            observer: ObserverParams::new(T::one(), velocity_bound).with_noise(sigma),
+            accel_noise: SVector::repeat(nalgebra::convert(1e-2)),
+            measurement: SMatrix::identity() * (sigma * sigma),
+            gate: chi_square_quantile(N, nalgebra::convert(4.0)),
+            max_outliers: 2,
+            initial_velocity_sigma: velocity_bound,
+        }
+    }
+
+    /// The same settings with the acceleration noise `q_a` on every
+    /// coordinate.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanParams;
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_accel_noise(0.5).scaled(2.0);
+    /// assert_eq!(p.accel_noise[1], 1.0);
+    /// ```
+    #[must_use]
+    pub fn with_accel_noise(self, q_a: T) -> Self {
+        Self {
+            accel_noise: SVector::repeat(q_a),
+            ..self
+        }
+    }
+
+    /// The same settings with the process noise scaled by `factor` (the
+    /// knob [`tune_process_noise`] turns).
+    #[must_use]
+    pub fn scaled(self, factor: T) -> Self {
+        Self {
+            accel_noise: self.accel_noise * factor,
+            ..self
+        }
+    }
+
+    /// Checks every setting.
+    fn check(&self) -> Result<(), T> {
+        self.observer.check()?;
+        let bad = |name, value| {
+            Err(ObserverError::Data(DataError::InvalidParams {
+                name,
+                value,
+            }))
+        };
+        for &a in self.accel_noise.iter() {
+            if !(a >= T::zero() && a.is_finite()) {
+                return bad("accel_noise", a);
+            }
+        }
+        let r = &self.measurement;
+        for i in 0..N {
+            for j in 0..N {
+                let x = r[(i, j)];
+                if !x.is_finite() || x != r[(j, i)] {
+                    return bad("measurement", x);
+                }
+            }
+            if r[(i, i)] < T::zero() {
+                return bad("measurement", r[(i, i)]);
+            }
+        }
+        if self.gate.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+            return bad("gate", self.gate);
+        }
+        let s = self.initial_velocity_sigma;
+        if !(s > T::zero() && s.is_finite()) {
+            return bad("initial_velocity_sigma", s);
+        }
+        Ok(())
+    }
+}
+
+/// What the last update of a [`SaltationKalman`] did, beyond the
+/// observers' [`UpdateReport`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KalmanReport<T> {
+    /// The normalised innovation squared `yᵀS⁻¹y`, `χ²_N` distributed when
+    /// the noise model is true.
+    pub nis: T,
+    /// `ln det S` of the innovation covariance.
+    pub log_det: T,
+    /// The sample failed the gate and was skipped.
+    pub outlier: bool,
+    /// The sample was used after consecutive outliers, with the
+    /// prediction's covariance inflated.
+    pub inflated: bool,
+    /// Saltation matrices applied (impacts and plastic closures).
+    pub saltations: u32,
+    /// Projections of the covariance onto a contact manifold.
+    pub projections: u32,
+}
+
+impl<T: RealField + Copy> KalmanReport<T> {
+    fn empty() -> Self {
+        Self {
+            nis: T::zero(),
+            log_det: T::zero(),
+            outlier: false,
+            inflated: false,
+            saltations: 0,
+            projections: 0,
+        }
+    }
+
+    /// The log-likelihood of the sample given the past ones,
+    /// `−½ (yᵀS⁻¹y + ln det S + N ln 2π)`, for `N` coordinates.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanReport;
+    ///
+    /// let r = KalmanReport { nis: 0.0, log_det: 0.0, outlier: false, inflated: false,
+    ///                        saltations: 0, projections: 0 };
+    /// let expected = -0.5 * (2.0 * std::f64::consts::PI).ln();
+    /// assert!((r.log_likelihood(1) - expected).abs() < 1e-15);
+    /// ```
+    pub fn log_likelihood(&self, n: usize) -> T {
+        let two_pi: T = nalgebra::convert(2.0 * core::f64::consts::PI);
+        let n: T = nalgebra::convert(n as f64);
+        -(self.nis + self.log_det + n * two_pi.ln()) * nalgebra::convert(0.5)
+    }
+}
+
+/// The saltation Kalman filter: the state `(q̂, v̂)` and its covariance
+/// `P` (`2N × 2N`, as [`Blocks`]) from noisy position samples at any rate,
+/// through impacts, accumulations and sliding (module docs of
+/// `runtime/src/observer/kalman/mod.rs`).
+///
+/// Its methods mirror [`Observer`](super::Observer)'s (`update`,
+/// `estimate`, `report`, `params`); it cannot implement that trait, whose
+/// `update` accepts any [`Model`](crate::Model), because the covariance needs the
+/// model's [`Sensitivities`] (every `model!` type has them).
+///
+/// ```
+/// use moreau_runtime::{KalmanParams, Model, ModelInfo, SaltationKalman, Sensitivities};
+/// use nalgebra::{Matrix1, SVector, Vector1};
+///
+/// /// A unit ball above the floor y ≥ 0, e = 0.8.
+/// struct Ball;
+/// impl Model<1, 1> for Ball {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 1> = ModelInfo {
+///         name: "Ball", coordinates: ["y"], velocities: ["vy"], constraints: ["floor"],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> { Vector1::new(9.81) }
+///     fn forces(&self, _: f64, _: &Vector1<f64>, _: &Vector1<f64>, _: &SVector<f64, 0>) -> Vector1<f64> {
+///         Vector1::new(9.81)
+///     }
+///     fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> { *q }
+///     fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn restitution(&self) -> Vector1<f64> { Vector1::new(0.8) }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+/// }
+/// impl Sensitivities<1, 1> for Ball {
+///     fn mass_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn jacobian_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+/// }
+///
+/// // dropped from 1 m at rest, bouncing at t₁ with 0.8 of its speed; exact
+/// // samples every 1 ms, and the filter starts believing v̂ = 0 ± 5 m/s
+/// let t1 = (2.0 / 9.81_f64).sqrt();
+/// let y = |t: f64| if t < t1 { 1.0 - 4.905 * t * t } else { 0.8 * 9.81 * t1 * (t - t1) - 4.905 * (t - t1).powi(2) };
+/// let v = |t: f64| if t < t1 { -9.81 * t } else { 0.8 * 9.81 * t1 - 9.81 * (t - t1) };
+/// let params = KalmanParams { initial_velocity_sigma: 5.0, ..KalmanParams::new(20.0, 0.0) };
+/// let mut filter = SaltationKalman::<f64, 1, 1>::new(params, 0.0, Vector1::new(1.0), Vector1::zeros())?;
+/// for k in 1..=500 {
+///     let t = k as f64 * 1e-3;
+///     let estimate = filter.update(&Ball, t, &Vector1::new(y(t)), &SVector::zeros())?;
+///     if k == 452 {
+///         // the bounce was located inside the last interval
+///         assert_eq!(filter.report().impacts, 1);
+///         assert_eq!(filter.kalman_report().saltations, 1);
+///         assert!((estimate.v[0] - v(t)).abs() < 1e-6);
+///     }
+/// }
+/// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> {
+    params: KalmanParams<T, N>,
+    restitution: Option<SVector<T, K>>,
+    lcp: Lcp<T>,
+    t: T,
+    q: SVector<T, N>,
+    v: SVector<T, N>,
+    p: Blocks<T, N>,
+    outliers: u32,
+    report: UpdateReport<T, N, K>,
+    kalman: KalmanReport<T>,
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
+    /// A filter with these settings, started at time `t0` from the first
+    /// measurement `q0` (its covariance `R`) and the velocity estimate `v0`
+    /// (standard deviation [`KalmanParams::initial_velocity_sigma`] per
+    /// coordinate).
+    ///
+    /// # Errors
+    ///
+    /// [`DataError::InvalidParams`](crate::DataError::InvalidParams) for a setting out of its range,
+    /// [`DataError::NonFinite`](crate::DataError::NonFinite) (`"q0"`, `"v0"`) or
+    /// [`ObserverError::InvalidTime`] for non-finite initial data.
+    pub fn new(
+        params: KalmanParams<T, N>,
+        t0: T,
+        q0: SVector<T, N>,
+        v0: SVector<T, N>,
+    ) -> Result<Self, T> {
+        params.check()?;
+        let s = params.initial_velocity_sigma;
+        let p = Blocks::diagonal(params.measurement, SMatrix::identity() * (s * s));
+        Self::with_covariance(params, t0, q0, v0, p)
+    }
+
+    /// A filter started from `(q0, v0)` with the covariance `p0`
+    /// (symmetric positive semi-definite).
+    ///
+    /// # Errors
+    ///
+    /// As [`SaltationKalman::new`], and [`DataError::InvalidParams`](crate::DataError::InvalidParams)
+    /// (`"p0"`) for a non-finite or non-symmetric `p0` or a negative
+    /// variance.
+    pub fn with_covariance(
+        params: KalmanParams<T, N>,
+        t0: T,
+        q0: SVector<T, N>,
+        v0: SVector<T, N>,
+        p0: Blocks<T, N>,
+    ) -> Result<Self, T> {
+        params.check()?;
+        if !t0.is_finite() {
+            return Err(ObserverError::InvalidTime { t: t0, last: t0 });
+        }
+        validate::finite_vector(&q0, "q0")?;
+        validate::finite_vector(&v0, "v0")?;
+        let bad = |value| {
+            Err(ObserverError::Data(DataError::InvalidParams {
+                name: "p0",
+                value,
+            }))
+        };
+        if !p0.is_finite() || p0.symmetrized() != p0 {
+            return bad(p0.trace());
+        }
+        for i in 0..2 * N {
+            if p0.entry(i, i) < T::zero() {
+                return bad(p0.entry(i, i));
+            }
+        }
+        Ok(Self {
+            params,
+            restitution: None,
+            lcp: Lcp::default(),
+            t: t0,
+            q: q0,
+            v: v0,
+            p: p0,
+            outliers: 0,
+            report: UpdateReport::new(t0, T::zero()),
+            kalman: KalmanReport::empty(),
+        })
+    }
+
+    /// The same filter with its own restitution coefficients `ê` instead
+    /// of the model's.
+    ///
+    /// # Errors
+    ///
+    /// [`DataError::InvalidRestitution`](crate::DataError::InvalidRestitution) for a coefficient outside
+    /// `[0, 1]`.
+    pub fn with_restitution(self, restitution: SVector<T, K>) -> Result<Self, T> {
+        validate::restitution(&restitution)?;
+        Ok(Self {
+            restitution: Some(restitution),
+            ..self
+        })
+    }
+
+    /// The current estimate `(q̂, v̂)`.
+    pub fn estimate(&self) -> Estimate<T, N> {
+        Estimate {
+            t: self.t,
+            q: self.q,
+            v: self.v,
+        }
+    }
+
+    /// The covariance `P` of the estimate.
+    pub fn covariance(&self) -> &Blocks<T, N> {
+        &self.p
+    }
+
+    /// What the last successful update's interval did (impacts, contacts,
+    /// the innovation).
+    pub fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
+    /// What the last successful update's covariance did (the normalised
+    /// innovation, the gate, saltations and projections).
+    pub fn kalman_report(&self) -> &KalmanReport<T> {
+        &self.kalman
+    }
+
+    /// The settings.
+    pub fn params(&self) -> &KalmanParams<T, N> {
+        &self.params
+    }
+
+    /// Takes the measurement `q` at time `t > t_k` (the known input `u`
+    /// applied over `[t_k, t]`) and returns the new estimate.
+    ///
+    /// # Errors
+    ///
+    /// An [`ObserverError`] naming the problem (a non-finite measurement,
+    /// input or parameter, a time not after the last, a model that
+    /// evaluates to NaN, an innovation covariance that is not positive
+    /// definite: `InvalidParams { name: "measurement" }`); the filter's
+    /// state is then unchanged, bit for bit. An outlier is no error: it is
+    /// reported in [`KalmanReport::outlier`].
+    pub fn update<M>(
+        &mut self,
+        model: &M,
+        t: T,
+        q: &SVector<T, N>,
+        u: &M::Input,
+    ) -> Result<Estimate<T, N>, T>
+    where
+        M: Sensitivities<N, K, Scalar = T>,
+    {
+        // the contact rule's band and velocity noise are those of the
+        // estimate the prediction starts from, not of a raw sample
+        let sigma_q = self.p.qq.diagonal().amax().max(T::zero()).sqrt();
+        let sigma_v = self.p.vv.diagonal().amax().max(T::zero()).sqrt();
+        let rule = ObserverParams {
+            noise: sigma_q.min(self.params.observer.noise),
+            ..self.params.observer
+        };
+        let memory = Memory {
+            params: &rule,
+            lcp: &self.lcp,
+            t: self.t,
+            q: self.q,
+            restitution: self.restitution,
+            report: &self.report,
+        };
+        let (mut interval, mut report) =
+            Interval::begin(model, u, memory, &mut Cache::default(), t, q)?;
+        let sigma = rule.noise;
+        interval.gain = if sigma > T::zero() {
+            sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
+        } else {
+            T::zero()
+        };
+        interval.uncertainty = rule.noise_sigmas * sigma_v;
+        report.gain = interval.gain;
+        // PREDICT, the covariance following every piece and impact
+        let mut propagation = Propagation {
+            model,
+            u,
+            t0: self.t,
+            bound: self.params.observer.velocity_bound,
+            density: self
+                .params
+                .accel_noise
+                .component_mul(&self.params.accel_noise),
+            p: self.p,
+            correction: (SVector::zeros(), SVector::zeros()),
+            saltations: 0,
+            projections: 0,
+        };
+        let (q_pred, v_pred) = interval.predict_traced(&self.v, &mut report, &mut propagation)?;
+        let (q_pred, v_pred) = (
+            q_pred + propagation.correction.0,
+            v_pred + propagation.correction.1,
+        );
+        let mut p = propagation.p;
+        let mut kalman = KalmanReport {
+            saltations: propagation.saltations,
+            projections: propagation.projections,
+            ..KalmanReport::empty()
+        };
+        // GATE the innovation
+        let y = q - q_pred;
+        report.innovation = y;
+        // R, plus the rounding of a sample stored in T (ε|q|) and of the
+        // covariance itself (64 ε its largest variance), so that exact
+        // samples (R = 0) never leave S singular
+        let eps = T::default_epsilon();
+        let rounding = eps * q.amax().max(T::one());
+        let floor = rounding * rounding + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax();
+        let r = self.params.measurement + SMatrix::<T, N, N>::identity() * floor;
+        let not_pd = || {
+            ObserverError::Data(DataError::InvalidParams {
+                name: "measurement",
+                value: r.trace(),
+            })
+        };
+        let mut s = p.qq + r;
+        let mut chol = nalgebra::linalg::Cholesky::new(s).ok_or_else(not_pd)?;
+        let mut nis = y.dot(&chol.solve(&y));
+        let mut outliers = self.outliers;
+        let gate = self.params.gate;
+        if nis > gate && self.outliers >= self.params.max_outliers {
+            // the model, not the sample, is wrong: widen the prediction
+            let factor = nis / nalgebra::convert(N.max(1) as f64);
+            p = Blocks {
+                qq: p.qq * factor,
+                qv: p.qv * factor,
+                vq: p.vq * factor,
+                vv: p.vv * factor,
+            };
+            kalman.inflated = true;
+            s = p.qq + r;
+            chol = nalgebra::linalg::Cholesky::new(s).ok_or_else(not_pd)?;
+            nis = y.dot(&chol.solve(&y));
+        }
+        kalman.nis = nis;
+        kalman.log_det = chol
+            .l()
+            .diagonal()
+            .iter()
+            .fold(T::zero(), |acc, &d| acc + d.ln())
+            * nalgebra::convert(2.0);
+        let (q_new, v_new) = if nis > gate && !kalman.inflated {
+            kalman.outlier = true;
+            outliers += 1;
+            (q_pred, v_pred)
+        } else {
+            outliers = 0;
+            // UPDATE, Joseph form
+            let k_q = chol.solve(&p.qq).transpose();
+            let k_v = chol.solve(&p.qv).transpose();
+            let id = SMatrix::<T, N, N>::identity();
+            let b = Blocks {
+                qq: id - k_q,
+                qv: SMatrix::zeros(),
+                vq: -k_v,
+                vv: id,
+            };
+            let joseph = b.congruence(&p);
+            let noise = Blocks {
+                qq: k_q * r * k_q.transpose(),
+                qv: k_q * r * k_v.transpose(),
+                vq: k_v * r * k_q.transpose(),
+                vv: k_v * r * k_v.transpose(),
+            };
+            p = joseph.add(&noise).symmetrized();
+            (q_pred + k_q * y, v_pred + k_v * y)
+        };
+        // WRITEBACK: only a finite result replaces the state
+        let finite = |x: &SVector<T, N>| x.iter().all(|x| x.is_finite());
+        if !(finite(&q_new) && finite(&v_new) && p.is_finite()) {
+            return Err(ObserverError::Data(DataError::NonFiniteResult));
+        }
+        (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
+        (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
+        Ok(self.estimate())
+    }
+}
+
+/// The covariance along the predicted motion of one interval.
+struct Propagation<'a, M, T, const N: usize, const K: usize>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    model: &'a M,
+    u: &'a M::Input,
+    t0: T,
+    bound: T,
+    /// `q_a²` per coordinate.
+    density: SVector<T, N>,
+    p: Blocks<T, N>,
+    /// The move of the predicted end onto the contact manifold, when the
+    /// last piece was a persistent contact.
+    correction: (SVector<T, N>, SVector<T, N>),
+    saltations: u32,
+    projections: u32,
+}
+
+/// `Q(h) = [[h³/3, h²/2], [h²/2, h]] ⊗ diag(q_a²)`: white acceleration
+/// noise integrated exactly over `h` for `q'' = w`.
+fn process_noise<T: RealField + Copy, const N: usize>(
+    density: &SVector<T, N>,
+    h: T,
+) -> Blocks<T, N> {
+    let d = SMatrix::<T, N, N>::from_diagonal(density);
+    let h2 = h * h;
+    let qv = d * (h2 * nalgebra::convert(0.5));
+    Blocks {
+        qq: d * (h2 * h / nalgebra::convert(3.0)),
+        qv,
+        vq: qv,
+        vv: d * h,
+    }
+}
+
+impl<M, T, const N: usize, const K: usize> Tracer<T, N, K> for Propagation<'_, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
+        let w0 = saturate(piece.w0, self.bound);
+        let t = self.t0 + piece.s0;
+        // the contacts that pushed along the piece
+        let mut held = IndexSet::EMPTY;
+        for i in piece.sliding.iter().filter(|&i| i < K) {
+            if piece.impulse[i] > T::zero() {
+                held.insert(i);
+            }
+        }
+        let (a, _) = if held.is_empty() {
+            flow_jacobian(self.model, t, piece.p0, &w0, self.u)?
+        } else {
+            constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
+        };
+        let noise = process_noise(&self.density, piece.h);
+        let mut p = transition(&a, piece.h).congruence(&self.p);
+        self.correction = (SVector::zeros(), SVector::zeros());
+        if held.is_empty() {
+            p = p.add(&noise);
+        } else {
+            p = p.add(&noise);
+            // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
+            // the covariance, and the state in the same metric
+            let (h, jac) = self.model.contact(piece.p1);
+            let rate = self.model.jacobian_dq(piece.p1, piece.w1);
+            validate::finite_model(&h, "h")?;
+            validate::finite_model(&jac, "J")?;
+            validate::finite_model(&rate, "d(Jv)/dq")?;
+            let mass = factor_mass(&self.model.mass(piece.p1))?;
+            if let Some((projected, dq, dv)) =
+                project_onto_contact(&p, &mass, &h, &jac, &rate, piece.w1, held)
+            {
+                p = projected;
+                self.correction = (dq, dv);
+                self.projections += 1;
+            }
+            // what the contact leaves uncertain across it: the noise's
+            // position and velocity variances, uncorrelated (a correlated
+            // floor would turn the contact's own penetration, seen in the
+            // samples, into a velocity)
+            p = p.add(&Blocks::diagonal(noise.qq, noise.vv));
+        }
+        self.p = p.symmetrized();
+        Ok(())
+    }
+
+    fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T> {
+        let mut active = IndexSet::EMPTY;
+        let mut e = SVector::<T, K>::zeros();
+        for i in jump.set.iter().filter(|&i| i < K) {
+            if jump.lambda[i] > T::zero() {
+                active.insert(i);
+                if jump.elastic.contains(i) {
+                    e[i] = jump.restitution[i];
+                }
+            }
+        }
+        if active.is_empty() {
+            return Ok(());
+        }
+        // the impact time moves with the constraint whose root timed it
+        // (the fastest-approaching if several), for an elastic law only
+        let (_, jac) = self.model.contact(jump.p);
+        let guard = jump
+            .guard
+            .intersection(jump.elastic)
+            .intersection(active)
+            .iter()
+            .filter(|&i| i < K)
+            .map(|i| {
+                let row = jac.row(i);
+                (i, row.dot(&jump.w_minus.transpose()) / row.norm())
+            })
+            .fold(None, |best: Option<(usize, T)>, (i, r)| match best {
+                Some((_, b)) if b <= r => best,
+                _ => Some((i, r)),
+            })
+            .map(|(i, _)| i);
+        self.correction = (SVector::zeros(), SVector::zeros());
+        let w = saturate(jump.w_minus, self.bound);
+        let s = saltation(
+            self.model,
+            self.t0 + jump.s,
+            jump.p,
+            &w,
+            self.u,
+            active,
+            &e,
+            guard,
+        )?;
+        self.p = s.matrix.congruence(&self.p);
+        self.saltations += 1;
+        Ok(())
+    }
+}

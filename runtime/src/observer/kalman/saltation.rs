@@ -1,0 +1,505 @@
+//! The derivatives of the hybrid flow that a covariance needs: the
+//! Jacobian of the free dynamics, its transition over a piece of flight,
+//! the saltation matrix of Newton's impact law, and the projection onto
+//! the manifold of a persistent contact. All from the model's generated
+//! derivatives ([`Model::linearization`](crate::Model::linearization), [`Sensitivities`]); nothing is
+//! differentiated numerically.
+
+use nalgebra::{RealField, SMatrix, SVector};
+
+use crate::lcp::IndexSet;
+use crate::linalg::Cholesky;
+use crate::model::Sensitivities;
+
+use super::super::ObserverError;
+use super::Blocks;
+use crate::error::DataError;
+use crate::validate::{factor_mass, finite_model as finite};
+
+type Result<X, T> = core::result::Result<X, ObserverError<T>>;
+
+/// The Jacobian `A = ∂f/∂x` of the free dynamics `x' = f(x) = (v, a)`,
+/// `a = −M(q)⁻¹ F(t, q, v, u)`, at one point, and `a` there:
+///
+/// $$A = \begin{pmatrix} 0 & I \\ -M^{-1}\big(\partial_q(M w)|_{w=a} + \partial_q F\big) & -M^{-1}\partial_v F \end{pmatrix}.$$
+///
+/// ```
+/// use moreau_runtime::{flow_jacobian, Model, ModelInfo, Sensitivities};
+/// use nalgebra::{Matrix1, SVector, Vector1};
+///
+/// /// A unit mass on a spring of stiffness 4: a = −4 y.
+/// struct Spring;
+/// impl Model<1, 0> for Spring {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 0> = ModelInfo {
+///         name: "Spring", coordinates: ["y"], velocities: ["vy"], constraints: [],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, q: &Vector1<f64>) -> Vector1<f64> { q * 4.0 }
+///     fn forces(&self, _: f64, q: &Vector1<f64>, _: &Vector1<f64>, _: &SVector<f64, 0>) -> Vector1<f64> { q * 4.0 }
+///     fn linearization(&self, t: f64, q: &Vector1<f64>, v: &Vector1<f64>, u: &SVector<f64, 0>)
+///         -> moreau_runtime::Linearization<f64, 1> {
+///         moreau_runtime::Linearization { mass: self.mass(q), forces: self.forces(t, q, v, u),
+///             forces_dq: Matrix1::new(4.0), forces_dv: Matrix1::zeros() }
+///     }
+///     fn gaps(&self, _: &Vector1<f64>) -> SVector<f64, 0> { SVector::zeros() }
+///     fn gap_jacobian(&self, _: &Vector1<f64>) -> nalgebra::SMatrix<f64, 0, 1> { nalgebra::SMatrix::zeros() }
+///     fn restitution(&self) -> SVector<f64, 0> { SVector::zeros() }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+/// }
+/// impl Sensitivities<1, 0> for Spring {
+///     fn mass_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn jacobian_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> nalgebra::SMatrix<f64, 0, 1> {
+///         nalgebra::SMatrix::zeros()
+///     }
+/// }
+///
+/// let (a, accel) = flow_jacobian(&Spring, 0.0, &Vector1::new(0.5), &Vector1::new(1.0), &SVector::zeros())?;
+/// assert_eq!(a.entry(0, 1), 1.0);
+/// assert_eq!(a.entry(1, 0), -4.0);
+/// assert_eq!(accel[0], -2.0);
+/// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
+/// ```
+///
+/// # Errors
+///
+/// [`DataError::NonFiniteModel`](crate::DataError::NonFiniteModel) or
+/// [`DataError::MassNotPositiveDefinite`](crate::DataError::MassNotPositiveDefinite) where the model fails.
+#[allow(clippy::type_complexity)]
+pub fn flow_jacobian<M, T, const N: usize, const K: usize>(
+    model: &M,
+    t: T,
+    q: &SVector<T, N>,
+    v: &SVector<T, N>,
+    u: &M::Input,
+) -> Result<(Blocks<T, N>, SVector<T, N>), T>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    let lin = model.linearization(t, q, v, u);
+    finite(&lin.forces, "F")?;
+    finite(&lin.forces_dq, "dF/dq")?;
+    finite(&lin.forces_dv, "dF/dv")?;
+    let chol = factor_mass(&lin.mass)?;
+    let accel = -chol.solve(&lin.forces);
+    let mass_dq = model.mass_dq(q, &accel);
+    finite(&mass_dq, "d(Mw)/dq")?;
+    let a = Blocks {
+        qq: SMatrix::zeros(),
+        qv: SMatrix::identity(),
+        vq: -chol.solve(&(mass_dq + lin.forces_dq)),
+        vv: -chol.solve(&lin.forces_dv),
+    };
+    Ok((a, accel))
+}
+
+/// The Jacobian of the constrained flow `x' = (v, a)` with the
+/// constraints of `set` held at acceleration level,
+/// `M a = −F + J_Sᵀ λ`, `J_S a + c = 0`, `c_i = vᵀ ∇²h_i v`
+/// (persistent contact: sliding or resting). With `W = J_S M⁻¹ J_Sᵀ`:
+///
+/// - `∂a/∂q = M⁻¹ (B + J_Sᵀ λ_q)`, `B = −∂F/∂q − ∂(M w)/∂q|_{w=a} + Σ λ_i ∇²h_i`,
+///   `λ_q = −W⁻¹ (∂(J_S w)/∂q|_{w=a} + J_S M⁻¹ B)`;
+/// - `∂a/∂v = M⁻¹ (−∂F/∂v + J_Sᵀ λ_v)`,
+///   `λ_v = −W⁻¹ (2 ∂(J_S v)/∂q − J_S M⁻¹ ∂F/∂v)`.
+///
+/// `∂c/∂q` needs third derivatives of `h` and is left out: exact for gaps
+/// of degree two (Example 1's parabola, the balls' distances, the
+/// billiard's walls), a Jacobian error of order `|v|² |∇³h|` otherwise.
+/// Constraints of `set` whose multiplier `λ_i` is not positive (the
+/// motion leaves them) are dropped. Falls back to [`flow_jacobian`] when
+/// none is left.
+///
+/// # Errors
+///
+/// As [`flow_jacobian`].
+#[allow(clippy::type_complexity)]
+pub fn constrained_flow_jacobian<M, T, const N: usize, const K: usize>(
+    model: &M,
+    t: T,
+    q: &SVector<T, N>,
+    v: &SVector<T, N>,
+    u: &M::Input,
+    set: IndexSet<K>,
+) -> Result<(Blocks<T, N>, SVector<T, N>), T>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    let lin = model.linearization(t, q, v, u);
+    finite(&lin.forces, "F")?;
+    finite(&lin.forces_dq, "dF/dq")?;
+    finite(&lin.forces_dv, "dF/dv")?;
+    let chol = factor_mass(&lin.mass)?;
+    let free = -chol.solve(&lin.forces);
+    let (_, jac) = model.contact(q);
+    finite(&jac, "J")?;
+    let rate_dq = model.jacobian_dq(q, v);
+    finite(&rate_dq, "d(Jv)/dq")?;
+    let c = rate_dq * v;
+    let mut active = IndexSet::<K>::EMPTY;
+    for i in set.iter().filter(|&i| i < K) {
+        active.insert(i);
+    }
+    // λ on the active rows; drop those that pull, once
+    let mut solved = None;
+    for _ in 0..2 {
+        let mut jac_a = SMatrix::<T, K, N>::zeros();
+        let mut w = SMatrix::<T, K, K>::identity();
+        for i in active {
+            jac_a.set_row(i, &jac.row(i));
+        }
+        let minv_jt = chol.solve(&jac_a.transpose());
+        let jmj = jac_a * minv_jt;
+        for i in active {
+            for j in active {
+                w[(i, j)] = jmj[(i, j)];
+            }
+        }
+        let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
+        let Some(w_chol) = Cholesky::new(&w) else {
+            break;
+        };
+        let mut rhs = -(jac_a * free);
+        for i in active {
+            rhs[i] -= c[i];
+        }
+        let lambda = w_chol.solve(&rhs);
+        let pulling = active.iter().filter(|&i| lambda[i] <= T::zero()).fold(
+            IndexSet::EMPTY,
+            |mut acc, i| {
+                acc.insert(i);
+                acc
+            },
+        );
+        if pulling.is_empty() {
+            solved = Some((jac_a, minv_jt, w_chol, lambda));
+            break;
+        }
+        active = active.difference(pulling);
+        if active.is_empty() {
+            break;
+        }
+    }
+    let Some((jac_a, minv_jt, w_chol, lambda)) = solved else {
+        return flow_jacobian(model, t, q, v, u);
+    };
+    let accel = free + minv_jt * lambda;
+    let mut h_lambda = SMatrix::<T, N, N>::zeros();
+    for k in 0..N {
+        let e_k = SVector::<T, N>::from_fn(|i, _| if i == k { T::one() } else { T::zero() });
+        h_lambda.set_column(k, &(model.jacobian_dq(q, &e_k).transpose() * lambda));
+    }
+    finite(&h_lambda, "d(Jv)/dq")?;
+    let mass_dq = model.mass_dq(q, &accel);
+    finite(&mass_dq, "d(Mw)/dq")?;
+    let mut d_j = SMatrix::<T, K, N>::zeros();
+    let mut c_v = SMatrix::<T, K, N>::zeros();
+    let accel_dq = model.jacobian_dq(q, &accel);
+    finite(&accel_dq, "d(Jv)/dq")?;
+    for i in active {
+        d_j.set_row(i, &accel_dq.row(i));
+        c_v.set_row(i, &(rate_dq.row(i) * nalgebra::convert::<f64, T>(2.0)));
+    }
+    let b = h_lambda - lin.forces_dq - mass_dq;
+    let minv_b = chol.solve(&b);
+    let lambda_q = -w_chol.solve(&(d_j + jac_a * minv_b));
+    let minv_fv = chol.solve(&lin.forces_dv);
+    let lambda_v = -w_chol.solve(&(c_v - jac_a * minv_fv));
+    let a = Blocks {
+        qq: SMatrix::zeros(),
+        qv: SMatrix::identity(),
+        vq: minv_b + minv_jt * lambda_q,
+        vv: -minv_fv + minv_jt * lambda_v,
+    };
+    Ok((a, accel))
+}
+
+/// The transition `Φ(h) = Σ_{j ≤ 4} (A h)^j / j!` of `x' = A x` over `h`:
+/// classical Runge–Kutta applied to the variational equation `Φ' = A Φ`
+/// with `A` held at the start of the piece (for a constant `A` this is
+/// exactly what the fourth-order Runge–Kutta prediction does to a
+/// perturbation of its initial point). No matrix exponential.
+///
+/// ```
+/// use moreau_runtime::{Blocks, transition};
+/// use nalgebra::Matrix1;
+///
+/// // q' = v, v' = 0: Φ(h) = [[1, h], [0, 1]] exactly
+/// let a = Blocks { qq: Matrix1::zeros(), qv: Matrix1::identity(), vq: Matrix1::zeros(), vv: Matrix1::zeros() };
+/// let phi = transition(&a, 0.25_f64);
+/// assert_eq!((phi.entry(0, 0), phi.entry(0, 1), phi.entry(1, 0), phi.entry(1, 1)), (1.0, 0.25, 0.0, 1.0));
+/// ```
+pub fn transition<T: RealField + Copy, const N: usize>(a: &Blocks<T, N>, h: T) -> Blocks<T, N> {
+    let scaled = |k: f64| {
+        let c = h / nalgebra::convert::<f64, T>(k);
+        Blocks {
+            qq: a.qq * c,
+            qv: a.qv * c,
+            vq: a.vq * c,
+            vv: a.vv * c,
+        }
+    };
+    let id = Blocks::identity();
+    let mut phi = id.add(&scaled(4.0));
+    for k in [3.0, 2.0, 1.0] {
+        phi = id.add(&scaled(k).mul(&phi));
+    }
+    phi
+}
+
+/// Newton's law on a set of active constraints and its saltation matrix
+/// (see [`saltation`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Saltation<T: RealField + Copy, const N: usize, const K: usize> {
+    /// The post-impact velocity `v⁺`.
+    pub v_plus: SVector<T, N>,
+    /// The impulses `λ` (zero off the active set).
+    pub lambda: SVector<T, K>,
+    /// `∂v⁺/∂v⁻`, the reset's velocity block `R`.
+    pub reset_dv: SMatrix<T, N, N>,
+    /// `∂v⁺/∂q` at fixed `v⁻`, the reset's configuration block `X`.
+    pub reset_dq: SMatrix<T, N, N>,
+    /// The saltation matrix `Ξ`: a perturbation `δx⁻` of the state just
+    /// before the impact becomes `Ξ δx⁻` just after it.
+    pub matrix: Blocks<T, N>,
+}
+
+/// Newton's law on the active set `active` (the constraints that end the
+/// impact with a positive impulse: the LCP's outcome) with the
+/// coefficients `e` (`e_i` as applied: `ê_i` for an elastic impact, `0`
+/// for a plastic closure), at `(t, q)` for the pre-impact velocity `v⁻`,
+/// and its saltation matrix for the impact triggered by the gap
+/// `h_guard` reaching zero.
+///
+/// With `J_A` the rows of `J(q)` on `A`, `W = J_A M⁻¹ J_Aᵀ` and
+/// `E = diag(e_A)`, the law `J_A (v⁺ + E v⁻) = 0`,
+/// `M (v⁺ − v⁻) = J_Aᵀ λ` gives `λ = −W⁻¹ (I + E) J_A v⁻` and the reset
+/// `Δ(q, v⁻) = (q, v⁺)` with
+///
+/// - `R = ∂v⁺/∂v⁻ = I − M⁻¹ J_Aᵀ W⁻¹ (I + E) J_A`,
+/// - `X = ∂v⁺/∂q = M⁻¹ (H_λ − D_M + J_Aᵀ Λ)`,
+///   `Λ = −W⁻¹ (D_J + J_A M⁻¹ (H_λ − D_M))`,
+///
+/// where `H_λ = Σ λ_i ∇²h_i` (from [`Sensitivities::jacobian_dq`] along
+/// the unit vectors), `D_M = ∂(M w)/∂q` at `w = v⁺ − v⁻`
+/// ([`Sensitivities::mass_dq`]) and row `i` of `D_J` is
+/// `∂(J_i (v⁺ + e_i v⁻))/∂q`. The impact time moves with the state: with
+/// `g = h_guard`, `f^∓ = (v^∓, a^∓)` the free vector fields on both sides
+/// and `DΔ = [[I, 0], [X, R]]`,
+///
+/// $$\Xi = D\Delta + \frac{(f^+ - D\Delta\, f^-)\,\nabla g^{\mathsf T}}{\nabla g \cdot f^-}.$$
+///
+/// With `guard = None` (a closed constraint met approaching, or an
+/// approach too slow to time) `Ξ = DΔ`. Several constraints may be
+/// active at once (a ball hitting a resting pair); the guard is the one
+/// whose crossing timed the impact.
+///
+/// ```
+/// use moreau_runtime::{saltation, IndexSet, Model, ModelInfo, Sensitivities};
+/// use nalgebra::{Matrix1, SVector, Vector1};
+///
+/// /// A unit ball above the floor y ≥ 0 under gravity 10.
+/// struct Ball;
+/// impl Model<1, 1> for Ball {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 1> = ModelInfo {
+///         name: "Ball", coordinates: ["y"], velocities: ["vy"], constraints: ["floor"],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> { Vector1::new(10.0) }
+///     fn forces(&self, _: f64, _: &Vector1<f64>, _: &Vector1<f64>, _: &SVector<f64, 0>) -> Vector1<f64> {
+///         Vector1::new(10.0)
+///     }
+///     fn gaps(&self, q: &Vector1<f64>) -> Vector1<f64> { *q }
+///     fn gap_jacobian(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn restitution(&self) -> Vector1<f64> { Vector1::new(0.5) }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+/// }
+/// impl Sensitivities<1, 1> for Ball {
+///     fn mass_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn jacobian_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+/// }
+///
+/// // landing at 4 m/s with e = 1/2: the classical bouncing-ball saltation
+/// // [[−e, 0], [(1 + e) g / |v⁻|, −e]]
+/// let s = saltation(&Ball, 0.0, &Vector1::new(0.0), &Vector1::new(-4.0), &SVector::zeros(),
+///                   IndexSet::full(1), &Vector1::new(0.5), Some(0))?;
+/// assert_eq!(s.v_plus[0], 2.0);
+/// let x = s.matrix;
+/// assert_eq!((x.entry(0, 0), x.entry(0, 1), x.entry(1, 0), x.entry(1, 1)), (-0.5, 0.0, 3.75, -0.5));
+/// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
+/// ```
+///
+/// # Errors
+///
+/// [`DataError::NonFiniteModel`](crate::DataError::NonFiniteModel) or
+/// [`DataError::MassNotPositiveDefinite`](crate::DataError::MassNotPositiveDefinite) where the model fails,
+/// [`DataError::InvalidParams`](crate::DataError::InvalidParams) (`"active"`) when the active rows of
+/// `J` are dependent (`W` singular).
+#[allow(clippy::too_many_arguments)]
+pub fn saltation<M, T, const N: usize, const K: usize>(
+    model: &M,
+    t: T,
+    q: &SVector<T, N>,
+    v_minus: &SVector<T, N>,
+    u: &M::Input,
+    active: IndexSet<K>,
+    e: &SVector<T, K>,
+    guard: Option<usize>,
+) -> Result<Saltation<T, N, K>, T>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    let (mass, forces_minus) = model.dynamics(t, q, v_minus, u);
+    finite(&forces_minus, "F")?;
+    let chol = factor_mass(&mass)?;
+    let (_, jac) = model.contact(q);
+    finite(&jac, "J")?;
+    // rows off the active set are zero, and W gets 1 on their diagonal
+    let mut jac_a = SMatrix::<T, K, N>::zeros();
+    let mut w = SMatrix::<T, K, K>::zeros();
+    let mut e_a = SVector::<T, K>::zeros();
+    for i in active.iter().filter(|&i| i < K) {
+        jac_a.set_row(i, &jac.row(i));
+        e_a[i] = e[i];
+    }
+    let minv_jt = chol.solve(&jac_a.transpose());
+    w += jac_a * minv_jt;
+    for i in 0..K {
+        if !active.contains(i) {
+            w[(i, i)] = T::one();
+        }
+    }
+    let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
+    let w_chol = Cholesky::new(&w).ok_or(ObserverError::Data(DataError::InvalidParams {
+        name: "active",
+        value: T::zero(),
+    }))?;
+    let one_plus_e = SMatrix::<T, K, K>::from_diagonal(&e_a.add_scalar(T::one()));
+    // λ and v⁺
+    let lambda = -w_chol.solve(&(one_plus_e * jac_a * v_minus));
+    let du = minv_jt * lambda;
+    let v_plus = v_minus + du;
+    // R = ∂v⁺/∂v⁻
+    let reset_dv = SMatrix::<T, N, N>::identity() - minv_jt * w_chol.solve(&(one_plus_e * jac_a));
+    // X = ∂v⁺/∂q
+    let mut h_lambda = SMatrix::<T, N, N>::zeros();
+    for k in 0..N {
+        let col = model
+            .jacobian_dq(
+                q,
+                &SVector::<T, N>::from_fn(|i, _| if i == k { T::one() } else { T::zero() }),
+            )
+            .transpose()
+            * lambda;
+        h_lambda.set_column(k, &col);
+    }
+    finite(&h_lambda, "d(Jv)/dq")?;
+    let d_m = model.mass_dq(q, &du);
+    finite(&d_m, "d(Mw)/dq")?;
+    let dj_plus = model.jacobian_dq(q, &v_plus);
+    let dj_minus = model.jacobian_dq(q, v_minus);
+    let mut d_j = SMatrix::<T, K, N>::zeros();
+    for i in active.iter().filter(|&i| i < K) {
+        d_j.set_row(i, &(dj_plus.row(i) + dj_minus.row(i) * e_a[i]));
+    }
+    finite(&d_j, "d(Jv)/dq")?;
+    let base = chol.solve(&(h_lambda - d_m));
+    let big_lambda = -w_chol.solve(&(d_j + jac_a * base));
+    let reset_dq = base + minv_jt * big_lambda;
+    let reset = Blocks {
+        qq: SMatrix::identity(),
+        qv: SMatrix::zeros(),
+        vq: reset_dq,
+        vv: reset_dv,
+    };
+    let mut matrix = reset;
+    if let Some(g) = guard.filter(|&g| g < K) {
+        let row = jac.row(g);
+        let rate = row.dot(&v_minus.transpose());
+        if rate < T::zero() {
+            let accel_minus = -chol.solve(&forces_minus);
+            let forces_plus = model.forces(t, q, &v_plus, u);
+            finite(&forces_plus, "F")?;
+            let accel_plus = -chol.solve(&forces_plus);
+            let dq = (v_plus - v_minus) / rate;
+            let dv = (accel_plus - reset_dq * v_minus - reset_dv * accel_minus) / rate;
+            matrix.qq += dq * row;
+            matrix.vq += dv * row;
+        }
+    }
+    Ok(Saltation {
+        v_plus,
+        lambda,
+        reset_dv,
+        reset_dq,
+        matrix,
+    })
+}
+
+/// Projects the state's perturbations onto the tangent space of the
+/// contact manifold `h_S(q) = 0`, `J_S(q) v = 0` at `(q, v)`, in the metric
+/// of the mass matrix (the metric of Newton's law: a plastic impact
+/// projects the velocity the same way). With `J⁺ = M⁻¹ J_Sᵀ (J_S M⁻¹
+/// J_Sᵀ)⁻¹`, `Π = I − J⁺ J_S` and `D = ∂(J_S v)/∂q`:
+///
+/// $$B = \begin{pmatrix} \Pi & 0 \\ -J^{+} D\, \Pi & \Pi \end{pmatrix},$$
+///
+/// a projector (`B² = B`) whose range satisfies `J_S δq = 0` and
+/// `D δq + J_S δv = 0`; `P ← B P Bᵀ` (a congruence: positive
+/// semi-definite whatever the round-off of `P`). The state moves onto the
+/// manifold along the same metric: `δq = −J⁺ h_S`, then
+/// `δv = −J⁺ (J_S v + D δq)`. Returns `(B P Bᵀ, δq, δv)`, or `None` when
+/// the rows of `set` are dependent.
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K: usize>(
+    p: &Blocks<T, N>,
+    mass: &Cholesky<T, N>,
+    h: &SVector<T, K>,
+    jac: &SMatrix<T, K, N>,
+    rate: &SMatrix<T, K, N>,
+    v: &SVector<T, N>,
+    set: IndexSet<K>,
+) -> Option<(Blocks<T, N>, SVector<T, N>, SVector<T, N>)> {
+    let mut j = SMatrix::<T, K, N>::zeros();
+    let mut d = SMatrix::<T, K, N>::zeros();
+    let mut w = SMatrix::<T, K, K>::identity();
+    let mut r_h = SVector::<T, K>::zeros();
+    for i in set.iter().filter(|&i| i < K) {
+        j.set_row(i, &jac.row(i));
+        d.set_row(i, &rate.row(i));
+        r_h[i] = h[i];
+    }
+    let minv_jt = mass.solve(&j.transpose());
+    let jmj = j * minv_jt;
+    for a in set.iter().filter(|&i| i < K) {
+        for b in set.iter().filter(|&i| i < K) {
+            w[(a, b)] = jmj[(a, b)];
+        }
+    }
+    let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
+    let w_chol = Cholesky::new(&w)?;
+    // J⁺ = M⁻¹Jᵀ W⁻¹ (N × K)
+    let pinv = w_chol.solve(&minv_jt.transpose()).transpose();
+    let pi = SMatrix::<T, N, N>::identity() - pinv * j;
+    let b = Blocks {
+        qq: pi,
+        qv: SMatrix::zeros(),
+        vq: -(pinv * d * pi),
+        vv: pi,
+    };
+    let dq = -(pinv * r_h);
+    let dv = -(pinv * (j * v + d * dq));
+    Some((b.congruence(p), dq, dv))
+}

@@ -1,0 +1,170 @@
+//! Picking the process noise from a recorded run by maximising the
+//! innovation likelihood.
+
+use nalgebra::{RealField, SVector};
+
+use crate::error::DataError;
+use crate::model::Sensitivities;
+
+use super::super::ObserverError;
+use super::{KalmanParams, KalmanReport, SaltationKalman};
+
+/// The outcome of [`tune_process_noise`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tuning<T: RealField + Copy, const N: usize> {
+    /// The settings with the chosen process noise.
+    pub params: KalmanParams<T, N>,
+    /// The factor applied to the given `accel_noise`.
+    pub factor: T,
+    /// The innovation log-likelihood of the run at that factor,
+    /// `Σ_k −½ (y_kᵀS_k⁻¹y_k + ln det S_k + N ln 2π)`.
+    pub log_likelihood: T,
+    /// Runs of the filter over the record.
+    pub evaluations: u32,
+}
+
+/// Picks the process noise of `params` for a recorded run by maximising
+/// the innovation log-likelihood over a factor `s` applied to
+/// [`KalmanParams::accel_noise`], `s ∈ [10^lo, 10^hi]`: a grid of nine
+/// points in `log s`, then golden-section search (24 steps) around the
+/// best point of the grid. Each evaluation runs a filter over the record
+/// from `(t[0], q[0])` with the velocity estimate `v0`; nothing allocates.
+///
+/// A user with data does not tune by hand: the likelihood is largest where
+/// the innovations are as large as the filter expects them, neither
+/// smaller (too much process noise: the filter follows the noise) nor
+/// larger (too little: it lags the motion).
+///
+/// ```
+/// use moreau_runtime::{KalmanParams, Model, ModelInfo, Sensitivities, tune_process_noise};
+/// use nalgebra::{Matrix1, SMatrix, SVector, Vector1};
+///
+/// /// A free unit mass on a line.
+/// struct Free;
+/// impl Model<1, 0> for Free {
+///     type Scalar = f64;
+///     type Input = SVector<f64, 0>;
+///     const INFO: ModelInfo<1, 0> = ModelInfo {
+///         name: "Free", coordinates: ["y"], velocities: ["vy"], constraints: [],
+///         parameters: &[], inputs: &[], source: "", op_count: 0,
+///     };
+///     fn mass(&self, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::new(1.0) }
+///     fn coriolis(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn gravity(&self, _: &Vector1<f64>) -> Vector1<f64> { Vector1::zeros() }
+///     fn forces(&self, _: f64, _: &Vector1<f64>, _: &Vector1<f64>, _: &SVector<f64, 0>) -> Vector1<f64> {
+///         Vector1::zeros()
+///     }
+///     fn gaps(&self, _: &Vector1<f64>) -> SVector<f64, 0> { SVector::zeros() }
+///     fn gap_jacobian(&self, _: &Vector1<f64>) -> SMatrix<f64, 0, 1> { SMatrix::zeros() }
+///     fn restitution(&self) -> SVector<f64, 0> { SVector::zeros() }
+///     fn parameter(&self, _: usize) -> Option<f64> { None }
+///     fn parameter_mut(&mut self, _: usize) -> Option<&mut f64> { None }
+/// }
+/// impl Sensitivities<1, 0> for Free {
+///     fn mass_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> Matrix1<f64> { Matrix1::zeros() }
+///     fn jacobian_dq(&self, _: &Vector1<f64>, _: &Vector1<f64>) -> SMatrix<f64, 0, 1> { SMatrix::zeros() }
+/// }
+///
+/// // a mass whose acceleration changes by a deterministic ±1 every 10 ms,
+/// // sampled exactly at 1 kHz: much more acceleration than the default
+/// let (mut y, mut v) = (0.0, 0.0);
+/// let (mut t, mut q) = (vec![0.0], vec![Vector1::new(0.0)]);
+/// for k in 1..=2000 {
+///     let a = if (k / 10) % 3 == 0 { 1.0 } else { -0.5 };
+///     y += v * 1e-3 + 0.5 * a * 1e-6;
+///     v += a * 1e-3;
+///     t.push(k as f64 * 1e-3);
+///     q.push(Vector1::new(y + 1e-5 * ((k * 7919) % 13) as f64 / 13.0));
+/// }
+/// let params = KalmanParams::<f64, 1>::new(10.0, 3e-6);
+/// let tuned = tune_process_noise::<_, _, 1, 0>(&Free, params, &t, &q, &Vector1::zeros(), &SVector::zeros(), (-2.0, 4.0))?;
+/// assert!(tuned.factor > 2.0, "{}", tuned.factor);
+/// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
+/// ```
+///
+/// # Errors
+///
+/// [`DataError::InvalidParams`](crate::DataError::InvalidParams) (`"record"`) when `t` and `q` differ in
+/// length or hold fewer than two samples, or `lo ≥ hi`; any error of the
+/// filter's construction or updates on the record.
+#[allow(clippy::too_many_arguments)]
+pub fn tune_process_noise<M, T, const N: usize, const K: usize>(
+    model: &M,
+    params: KalmanParams<T, N>,
+    t: &[T],
+    q: &[SVector<T, N>],
+    v0: &SVector<T, N>,
+    u: &M::Input,
+    (lo, hi): (T, T),
+) -> Result<Tuning<T, N>, ObserverError<T>>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    if t.len() != q.len() || t.len() < 2 || !(lo < hi && (hi - lo).is_finite()) {
+        return Err(ObserverError::Data(DataError::InvalidParams {
+            name: "record",
+            value: nalgebra::convert(t.len() as f64),
+        }));
+    }
+    let ten: T = nalgebra::convert(10.0);
+    let mut evaluations = 0u32;
+    let mut likelihood = |x: T| -> Result<T, ObserverError<T>> {
+        evaluations += 1;
+        let p = params.scaled(ten.powf(x));
+        let mut filter = SaltationKalman::<T, N, K>::new(p, t[0], q[0], *v0)?;
+        let mut total = T::zero();
+        for (&tk, qk) in t.iter().zip(q).skip(1) {
+            filter.update(model, tk, qk, u)?;
+            // a sample past the gate counts as at the gate: one impact
+            // the model places a sample off must not set the noise level
+            // of the whole run
+            let r = filter.kalman_report();
+            let capped = KalmanReport {
+                nis: r.nis.min(p.gate),
+                ..*r
+            };
+            total += capped.log_likelihood(N);
+        }
+        Ok(total)
+    };
+    // a grid in log s, then golden-section search around its best point
+    const GRID: usize = 9;
+    let step = (hi - lo) / nalgebra::convert((GRID - 1) as f64);
+    let (mut best_x, mut best) = (
+        lo,
+        T::min_value().unwrap_or(-T::one() / T::default_epsilon()),
+    );
+    let mut first = true;
+    for j in 0..GRID {
+        let x = lo + step * nalgebra::convert(j as f64);
+        let l = likelihood(x)?;
+        if first || l > best {
+            (best_x, best, first) = (x, l, false);
+        }
+    }
+    let ratio: T = nalgebra::convert(0.618_033_988_749_895);
+    let (mut a, mut b) = ((best_x - step).max(lo), (best_x + step).min(hi));
+    let mut c = b - (b - a) * ratio;
+    let mut d = a + (b - a) * ratio;
+    let (mut fc, mut fd) = (likelihood(c)?, likelihood(d)?);
+    for _ in 0..24 {
+        if fc > fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - (b - a) * ratio;
+            fc = likelihood(c)?;
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + (b - a) * ratio;
+            fd = likelihood(d)?;
+        }
+    }
+    let (x, l) = if fc > fd { (c, fc) } else { (d, fd) };
+    let (x, l) = if l > best { (x, l) } else { (best_x, best) };
+    Ok(Tuning {
+        params: params.scaled(ten.powf(x)),
+        factor: ten.powf(x),
+        log_likelihood: l,
+        evaluations,
+    })
+}

@@ -1,0 +1,1175 @@
+//! The saltation Kalman filter end to end, beside the observers (36) and
+//! (38): reference trajectories from the plant `MoreauJean` (a step a
+//! hundred times finer than the sampling period for Example 1), sampled,
+//! with seeded Gaussian noise where stated; the true velocity is the
+//! plant's at the sample times, and no estimator ever sees it.
+//!
+//! Run with `cargo test --release --test kalman -- --nocapture` to see
+//! every measured figure.
+
+use moreau::{
+    Blocks, DataError, Estimate, IndexSet, KalmanParams, Lcp, Model, MoreauJean, Observer,
+    ObserverError, ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, State, StepParams,
+    saltation, tune_process_noise,
+};
+use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
+
+// ---------------------------------------------------------------------------
+// Reference data (as in tests/observer.rs)
+
+/// A plant trajectory sampled for an observer.
+struct Reference<const N: usize> {
+    /// The plant state at each sample time `t_j = j τ_s`.
+    samples: Vec<State<f64, N>>,
+    /// Plant impacts: (time, constraint, normal approach speed) for every
+    /// plant step whose LCP gave an impulse to a constraint approaching
+    /// faster than `min_impact_speed` (slower ones are resting contact).
+    impacts: Vec<(f64, usize, f64)>,
+}
+
+/// Runs the plant from `(q0, v0)` at step `tau` for `t_end` and keeps every
+/// `every`-th state.
+fn reference<M, const N: usize, const K: usize>(
+    model: &M,
+    (q0, v0): (SVector<f64, N>, SVector<f64, N>),
+    tau: f64,
+    every: usize,
+    t_end: f64,
+    u: &M::Input,
+) -> Reference<N>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let min_impact_speed = 1e-2;
+    assert!(
+        model.gaps(&q0).iter().all(|&h| h >= 0.0),
+        "infeasible start {q0}"
+    );
+    let stepper = MoreauJean::new(StepParams::new(tau)).unwrap();
+    let mut state = State::new(0.0, q0, v0);
+    let mut samples = vec![state];
+    let mut impacts = Vec::new();
+    let steps = (t_end / tau).round() as usize;
+    for k in 1..=steps {
+        let before = state;
+        let report = stepper.step(model, &mut state, u).unwrap();
+        let jac = model.gap_jacobian(&before.q);
+        for i in report.impacting() {
+            let approach = -jac.row(i).dot(&before.v.transpose());
+            if approach > min_impact_speed {
+                impacts.push((state.t, i, approach));
+            }
+        }
+        if k % every == 0 {
+            // the plant's t accumulates round-off: sample at exactly j τ_s
+            state.t = (k / every) as f64 * tau * every as f64;
+            samples.push(state);
+        }
+    }
+    Reference { samples, impacts }
+}
+
+/// A tiny deterministic Gaussian generator: xorshift64* and Box–Muller.
+struct Gauss {
+    state: u64,
+    spare: Option<f64>,
+}
+
+impl Gauss {
+    fn new(seed: u64) -> Self {
+        Self {
+            state: seed.max(1),
+            spare: None,
+        }
+    }
+
+    /// Uniform in (0, 1].
+    fn uniform(&mut self) -> f64 {
+        self.state ^= self.state >> 12;
+        self.state ^= self.state << 25;
+        self.state ^= self.state >> 27;
+        let x = self.state.wrapping_mul(0x2545_F491_4F6C_DD1D);
+        ((x >> 11) as f64 + 1.0) / (1u64 << 53) as f64
+    }
+
+    /// Standard normal.
+    fn normal(&mut self) -> f64 {
+        if let Some(z) = self.spare.take() {
+            return z;
+        }
+        let (u1, u2) = (self.uniform(), self.uniform());
+        let r = (-2.0 * u1.ln()).sqrt();
+        let angle = 2.0 * std::f64::consts::PI * u2;
+        self.spare = Some(r * angle.sin());
+        r * angle.cos()
+    }
+}
+
+/// The measured positions: the plant's, plus Gaussian noise of standard
+/// deviation `sigma` on each coordinate (none for `sigma = 0`).
+fn measure<const N: usize>(
+    reference: &Reference<N>,
+    sigma: f64,
+    seed: u64,
+) -> Vec<SVector<f64, N>> {
+    let mut gauss = Gauss::new(seed);
+    reference
+        .samples
+        .iter()
+        .map(|s| s.q + SVector::from_fn(|_, _| sigma * gauss.normal()))
+        .collect()
+}
+
+/// `|v − v̂|` at every sample.
+fn errors<const N: usize>(reference: &Reference<N>, estimates: &[Estimate<f64, N>]) -> Vec<f64> {
+    reference
+        .samples
+        .iter()
+        .zip(estimates)
+        .map(|(s, e)| (s.v - e.v).norm())
+        .collect()
+}
+
+/// Median, 90th percentile and maximum.
+#[derive(Clone, Copy, Debug)]
+struct Figures {
+    median: f64,
+    p90: f64,
+    max: f64,
+}
+
+fn figures(errors: &[f64]) -> Figures {
+    let mut sorted = errors.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    Figures {
+        median: sorted[n / 2],
+        p90: sorted[(n * 9) / 10],
+        max: sorted[n - 1],
+    }
+}
+
+/// Feeds the measurements (from the second on) to the filter and returns
+/// the estimates, the initial one first.
+fn filter_run<M, const N: usize, const K: usize>(
+    filter: &mut SaltationKalman<f64, N, K>,
+    model: &M,
+    reference: &Reference<N>,
+    measured: &[SVector<f64, N>],
+    u: &M::Input,
+) -> Vec<Estimate<f64, N>>
+where
+    M: Sensitivities<N, K, Scalar = f64>,
+{
+    let mut estimates = vec![filter.estimate()];
+    for (s, q) in reference.samples.iter().zip(measured).skip(1) {
+        let before = *filter.covariance();
+        estimates.push(
+            filter
+                .update(model, s.t, q, u)
+                .unwrap_or_else(|e| panic!("t = {}: {e:?} {before:?} {:?}", s.t, filter.report())),
+        );
+    }
+    estimates
+}
+
+/// Example 1's initial states: the model file's (impacts accumulate at
+/// 4.456 s and the mass slides on), and three more.
+fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
+    vec![
+        Parabola::<f64>::initial_state(),
+        (Vector2::new(-1.0, 3.0), Vector2::new(-2.0, 5.0)),
+        (Vector2::new(0.5, 6.0), Vector2::new(4.0, 0.0)),
+        (Vector2::new(0.2, 1.0), Vector2::new(1.0, -2.0)),
+    ]
+}
+
+// ---------------------------------------------------------------------------
+// Saltation matrices against finite differences of flow–impact–flow
+
+/// The state `(q, v)` as one vector of length `2N` (a `DVector`: the test
+/// may allocate).
+fn stack<const N: usize>(q: &SVector<f64, N>, v: &SVector<f64, N>) -> DVector<f64> {
+    DVector::from_iterator(2 * N, q.iter().chain(v.iter()).copied())
+}
+
+fn unstack<const N: usize>(x: &DVector<f64>) -> (SVector<f64, N>, SVector<f64, N>) {
+    (
+        SVector::from_fn(|i, _| x[i]),
+        SVector::from_fn(|i, _| x[N + i]),
+    )
+}
+
+/// `A⁻¹ B` by a dense LU (tests may allocate).
+fn solve<const N: usize, const C: usize>(
+    a: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, C>,
+) -> SMatrix<f64, N, C> {
+    let x = DMatrix::from_fn(N, N, |i, j| a[(i, j)])
+        .lu()
+        .solve(&DMatrix::from_fn(N, C, |i, j| b[(i, j)]))
+        .unwrap();
+    SMatrix::from_fn(|i, j| x[(i, j)])
+}
+
+/// One classical Runge–Kutta step of the free dynamics.
+fn rk4_step<M, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    x: &DVector<f64>,
+    h: f64,
+) -> DVector<f64>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let f = |x: &DVector<f64>| {
+        let (q, v) = unstack::<N>(x);
+        let (m, force) = model.dynamics(0.0, &q, &v, u);
+        let a = solve(&m, &(-force));
+        stack(&v, &a)
+    };
+    let k1 = f(x);
+    let k2 = f(&(x + &k1 * (h / 2.0)));
+    let k3 = f(&(x + &k2 * (h / 2.0)));
+    let k4 = f(&(x + &k3 * h));
+    x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0)
+}
+
+/// The free flow over `t` (either sign) in steps of at most `1e-5`.
+fn flow<M, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    x: &DVector<f64>,
+    t: f64,
+) -> DVector<f64>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let steps = (t.abs() / 1e-5).ceil().max(1.0) as usize;
+    let h = t / steps as f64;
+    (0..steps).fold(x.clone(), |x, _| rk4_step::<M, N, K>(model, u, &x, h))
+}
+
+/// Free flow from `x0` until the gap `guard` closes: returns the state
+/// there and the time taken (root to round-off by the secant method on the
+/// length of the last Runge–Kutta step).
+fn flow_to_guard<M, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    x0: &DVector<f64>,
+    guard: usize,
+) -> (DVector<f64>, f64)
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let gap = |x: &DVector<f64>| model.gaps(&unstack::<N>(x).0)[guard];
+    let h = 1e-5;
+    let (mut x, mut t) = (x0.clone(), 0.0);
+    loop {
+        let next = rk4_step::<M, N, K>(model, u, &x, h);
+        if gap(&next) <= 0.0 {
+            let (mut a, mut fa, mut b, mut fb) = (0.0, gap(&x), h, gap(&next));
+            for _ in 0..60 {
+                if fb == fa || (b - a).abs() < 1e-18 {
+                    break;
+                }
+                let c = b - fb * (b - a) / (fb - fa);
+                let fc = gap(&rk4_step::<M, N, K>(model, u, &x, c));
+                (a, fa, b, fb) = (b, fb, c, fc);
+            }
+            return (rk4_step::<M, N, K>(model, u, &x, b), t + b);
+        }
+        (x, t) = (next, t + h);
+        assert!(t < 1.0, "the guard never closes");
+    }
+}
+
+/// Newton's law by the LCP on `set`, `e` as applied.
+fn newton_reset<M, const N: usize, const K: usize>(
+    model: &M,
+    q: &SVector<f64, N>,
+    v: &SVector<f64, N>,
+    set: IndexSet<K>,
+    e: &SVector<f64, K>,
+) -> (SVector<f64, N>, SVector<f64, K>)
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let m = model.mass(q);
+    let jac = model.gap_jacobian(q);
+    let minv_jt = solve(&m, &jac.transpose());
+    let w = jac * minv_jt;
+    let b = jac * v + e.component_mul(&(jac * v));
+    let lambda = Lcp::default().solve(&w, &b, set).unwrap().lambda;
+    (v + minv_jt * lambda, lambda)
+}
+
+/// Flow for `t1` from `x0` through the impact on `guard` (Newton's law on
+/// `set`), then on to `t_end` in all.
+fn flow_impact_flow<M, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    x0: &DVector<f64>,
+    guard: usize,
+    set: IndexSet<K>,
+    e: &SVector<f64, K>,
+    t_end: f64,
+) -> DVector<f64>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let (x, t) = flow_to_guard::<M, N, K>(model, u, x0, guard);
+    let (q, v) = unstack::<N>(&x);
+    let (v_plus, _) = newton_reset::<M, N, K>(model, &q, &v, set, e);
+    flow::<M, N, K>(model, u, &stack(&q, &v_plus), t_end - t)
+}
+
+/// Jacobian of `f` at `x` by central differences.
+fn jacobian_fd(f: impl Fn(&DVector<f64>) -> DVector<f64>, x: &DVector<f64>) -> DMatrix<f64> {
+    let n = x.len();
+    let mut jac = DMatrix::zeros(n, n);
+    for j in 0..n {
+        let step = 1e-6 * x[j].abs().max(1.0);
+        let mut plus = x.clone();
+        plus[j] += step;
+        let mut minus = x.clone();
+        minus[j] -= step;
+        jac.set_column(j, &((f(&plus) - f(&minus)) / (2.0 * step)));
+    }
+    jac
+}
+
+fn dense<const N: usize>(b: &Blocks<f64, N>) -> DMatrix<f64> {
+    DMatrix::from_fn(2 * N, 2 * N, |i, j| b.entry(i, j))
+}
+
+/// Moves `q` onto `h_guard = 0` along the gradient (Newton).
+fn onto<M, const N: usize, const K: usize>(
+    model: &M,
+    mut q: SVector<f64, N>,
+    guard: usize,
+) -> SVector<f64, N>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    for _ in 0..50 {
+        let (h, jac) = model.contact(&q);
+        let g = jac.row(guard).transpose();
+        q -= g * (h[guard] / g.norm_squared());
+    }
+    q
+}
+
+/// The saltation matrix at `(q*, v*)` (`q*` on `h_guard = 0`, `v*`
+/// approaching) against finite differences: with `δ = 1 ms` of free flow
+/// before and after, the Jacobian of flow–impact–flow from `x(−δ)` equals
+/// `Φ_after · Ξ · Φ_before`, both flows' Jacobians by finite differences
+/// too. Returns the relative error.
+fn saltation_error<M, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    q_star: SVector<f64, N>,
+    v_star: SVector<f64, N>,
+    guard: usize,
+    set: IndexSet<K>,
+    e: SVector<f64, K>,
+) -> (f64, usize)
+where
+    M: Sensitivities<N, K, Scalar = f64>,
+{
+    let delta = 1e-3;
+    let x_star = stack(&q_star, &v_star);
+    let x0 = flow::<M, N, K>(model, u, &x_star, -delta);
+    // the impact the finite differences see: the LCP's active set
+    let (x_minus, t_hit) = flow_to_guard::<M, N, K>(model, u, &x0, guard);
+    let (q_hit, v_hit) = unstack::<N>(&x_minus);
+    let (_, lambda) = newton_reset::<M, N, K>(model, &q_hit, &v_hit, set, &e);
+    assert!(
+        lambda.iter().any(|&l| l > 0.0),
+        "{}: no impulse, no impact",
+        M::INFO.name
+    );
+    let active =
+        IndexSet::from_indices(&(0..K).filter(|&i| lambda[i] > 0.0).collect::<Vec<_>>()).unwrap();
+    let salt = saltation(model, 0.0, &q_hit, &v_hit, u, active, &e, Some(guard)).unwrap();
+    let x_plus = stack(&q_hit, &salt.v_plus);
+    let total = jacobian_fd(
+        |x| flow_impact_flow::<M, N, K>(model, u, x, guard, set, &e, 2.0 * delta),
+        &x0,
+    );
+    let before = jacobian_fd(|x| flow::<M, N, K>(model, u, x, t_hit), &x0);
+    let after = jacobian_fd(
+        |x| flow::<M, N, K>(model, u, x, 2.0 * delta - t_hit),
+        &x_plus,
+    );
+    let predicted = &after * dense(&salt.matrix) * &before;
+    let error = (&total - &predicted).abs().max() / total.abs().max();
+    // the check can fail: the reset's Jacobian alone, without the moving
+    // impact time, is far off
+    let reset = Blocks {
+        qq: SMatrix::identity(),
+        qv: SMatrix::zeros(),
+        vq: salt.reset_dq,
+        vv: salt.reset_dv,
+    };
+    let without_time = (&total - &after * dense(&reset) * &before).abs().max() / total.abs().max();
+    assert!(
+        without_time > 1e-2,
+        "{} without the time term: {without_time:e}",
+        M::INFO.name
+    );
+    (error, active.len())
+}
+
+/// Every shipped model, every kind of impact it has: a single constraint
+/// on a flat or curved surface (Parabola's floor and ceiling, the
+/// billiard's inward-curving wall, the double pendulum's wall and floor,
+/// the arm's wall with its configuration-dependent mass), and the three
+/// balls' simultaneous impact (ball 1 hits the resting pair 2–3: the LCP
+/// ends with two active constraints, one elastic and one plastic).
+#[test]
+fn saltation_matrices_match_finite_differences_of_flow_impact_flow() {
+    let mut worst: f64 = 0.0;
+    let mut check = |name: &str, (err, active): (f64, usize)| {
+        eprintln!("saltation {name}: {active} active, relative error {err:.2e}");
+        // the balls' impact ends with both contacts active; every other
+        // case with its one constraint
+        assert_eq!(active, if name.contains("pair") { 2 } else { 1 }, "{name}");
+        assert!(err < 1e-5, "{name}: {err:e}");
+        worst = worst.max(err);
+    };
+    let p = Parabola::<f64>::new();
+    let u0 = SVector::<f64, 0>::zeros();
+    check(
+        "Parabola floor",
+        saltation_error(
+            &p,
+            &u0,
+            Vector2::new(1.0, 1.0),
+            Vector2::new(-1.0, -5.0),
+            0,
+            IndexSet::from_indices(&[0]).unwrap(),
+            Vector2::new(0.9, 0.0),
+        ),
+    );
+    check(
+        "Parabola floor, plastic",
+        saltation_error(
+            &p,
+            &u0,
+            Vector2::new(-0.5, 0.25),
+            Vector2::new(-2.0, -1.5),
+            0,
+            IndexSet::from_indices(&[0]).unwrap(),
+            Vector2::new(0.0, 0.0),
+        ),
+    );
+    check(
+        "Parabola ceiling",
+        saltation_error(
+            &p,
+            &u0,
+            Vector2::new(0.5, 8.0),
+            Vector2::new(1.0, 3.0),
+            1,
+            IndexSet::from_indices(&[1]).unwrap(),
+            Vector2::new(0.0, 0.9),
+        ),
+    );
+    let b = Billiard::<f64>::new();
+    check(
+        "Billiard right wall",
+        saltation_error(
+            &b,
+            &u0,
+            Vector2::new(0.2, 0.0),
+            Vector2::new(1.0, 0.5),
+            0,
+            IndexSet::from_indices(&[0]).unwrap(),
+            SVector::<f64, 4>::repeat(0.8),
+        ),
+    );
+    let d = DoublePendulum::<f64>::new();
+    let q = onto::<_, 2, 2>(&d, Vector2::new(0.5, 0.7), 0);
+    check(
+        "DoublePendulum wall",
+        saltation_error(
+            &d,
+            &u0,
+            q,
+            Vector2::new(1.0, 2.0),
+            0,
+            IndexSet::from_indices(&[0]).unwrap(),
+            Vector2::new(0.8, 0.0),
+        ),
+    );
+    let q = onto::<_, 2, 2>(&d, Vector2::new(0.3, 0.87), 1);
+    check(
+        "DoublePendulum floor",
+        saltation_error(
+            &d,
+            &u0,
+            q,
+            Vector2::new(-1.0, -1.0),
+            1,
+            IndexSet::from_indices(&[1]).unwrap(),
+            Vector2::new(0.0, 0.8),
+        ),
+    );
+    let a = Arm3::<f64>::new();
+    let u3 = SVector::<f64, 3>::zeros();
+    let q = onto::<_, 3, 1>(&a, Vector3::new(0.9, -0.6, -0.4), 0);
+    let grad = a.gap_jacobian(&q).row(0).transpose();
+    let v = -grad * 2.0 + Vector3::new(0.3, -0.2, 0.1);
+    assert!(a.gap_jacobian(&q).row(0).dot(&v.transpose()) < 0.0);
+    check(
+        "Arm3 wall",
+        saltation_error(
+            &a,
+            &u3,
+            q,
+            v,
+            0,
+            IndexSet::full(1),
+            SVector::<f64, 1>::new(0.5),
+        ),
+    );
+    let t = ThreeBalls::<f64>::new();
+    let r = 0.125;
+    let q = Vector3::new(1.0, 1.0 + 2.0 * r, 1.0 + 4.0 * r);
+    check(
+        "ThreeBalls 1 on the resting pair",
+        saltation_error(
+            &t,
+            &u0,
+            q,
+            Vector3::new(2.0, 0.0, 0.0),
+            1,
+            IndexSet::from_indices(&[1, 2]).unwrap(),
+            SVector::<f64, 4>::new(0.0, 0.9, 0.0, 0.0),
+        ),
+    );
+    check(
+        "ThreeBalls left wall",
+        saltation_error(
+            &t,
+            &u0,
+            Vector3::new(r, 1.0, 1.5),
+            Vector3::new(-1.5, 0.3, 0.0),
+            0,
+            IndexSet::from_indices(&[0]).unwrap(),
+            SVector::<f64, 4>::new(0.7, 0.0, 0.0, 0.0),
+        ),
+    );
+    eprintln!("worst {worst:.2e}");
+}
+
+// ---------------------------------------------------------------------------
+// Consistency where the noise model is true
+
+/// `χ²` with `dof` degrees of freedom, `z` standard deviations out
+/// (Wilson–Hilferty, accurate to a few 1e-3 relative from 100 degrees of
+/// freedom up).
+fn chi_square(dof: f64, z: f64) -> f64 {
+    let c = 2.0 / (9.0 * dof);
+    dof * (1.0 - c + z * c.sqrt()).powi(3)
+}
+
+/// Runs where the filter's noise model is the truth: Example 1's mass with
+/// gravity switched off (the parameter `g = 0`) driven by white
+/// acceleration noise of density `q_a` on each coordinate, drawn exactly
+/// for one sampling interval (`[[τ³/3, τ²/2], [τ²/2, τ]] q_a²` per
+/// coordinate), away from the walls; positions sampled at 1 kHz with
+/// Gaussian noise `σ`. Over 100 independent runs (seeded), the sums of the
+/// normalised innovation squared (2 degrees of freedom) and of the
+/// normalised estimation error squared `x̃ᵀP⁻¹x̃` (4) at a fixed time are
+/// `χ²` with 200 and 400 degrees of freedom; both must lie inside their
+/// two-sided 99.9 % bounds at each of three times.
+#[test]
+fn nis_and_nees_are_chi_square_where_the_noise_model_is_true() {
+    let mut model = Parabola::<f64>::new();
+    *model
+        .parameter_mut(Parabola::<f64>::parameter_index("g").unwrap())
+        .unwrap() = 0.0;
+    let u = SVector::zeros();
+    let (tau, q_a, sigma, runs): (f64, f64, f64, usize) = (1e-3, 0.05, 1e-4, 100);
+    let checks = [500usize, 1000, 2000];
+    let mut nis = vec![0.0; checks.len()];
+    let mut nees = vec![0.0; checks.len()];
+    // one coordinate's exact noise over τ: its Cholesky factor
+    let (a, b, c) = (tau.powi(3) / 3.0, tau * tau / 2.0, tau);
+    let l11 = a.sqrt();
+    let l21 = b / l11;
+    let l22 = (c - l21 * l21).sqrt();
+    for run in 0..runs {
+        let mut gauss = Gauss::new(1 + run as u64);
+        let mut q = Vector2::new(0.0, 4.0);
+        let mut v = Vector2::new(0.1, -0.1);
+        let measured0 = q + Vector2::from_fn(|_, _| sigma * gauss.normal());
+        let params = KalmanParams::new(20.0, sigma).with_accel_noise(q_a);
+        let p0 = Blocks::diagonal(
+            SMatrix::identity() * sigma * sigma,
+            SMatrix::identity() * 1.0,
+        );
+        let mut filter = SaltationKalman::<f64, 2, 2>::with_covariance(
+            params,
+            0.0,
+            measured0,
+            Vector2::zeros(),
+            p0,
+        )
+        .unwrap();
+        for k in 1..=checks[checks.len() - 1] {
+            for i in 0..2 {
+                let (z1, z2) = (gauss.normal(), gauss.normal());
+                q[i] += v[i] * tau + q_a * l11 * z1;
+                v[i] += q_a * (l21 * z1 + l22 * z2);
+            }
+            let y = q + Vector2::from_fn(|_, _| sigma * gauss.normal());
+            let e = filter.update(&model, k as f64 * tau, &y, &u).unwrap();
+            assert_eq!(
+                filter.report().contacts,
+                IndexSet::EMPTY,
+                "the walls are far"
+            );
+            if let Some(j) = checks.iter().position(|&c| c == k) {
+                nis[j] += filter.kalman_report().nis;
+                let p = dense(filter.covariance());
+                let err =
+                    DVector::from_iterator(4, (q - e.q).iter().chain((v - e.v).iter()).copied());
+                nees[j] += (err.transpose() * p.lu().solve(&err).unwrap())[0];
+            }
+        }
+    }
+    let z = 3.29; // two-sided 99.9 %
+    for (j, &k) in checks.iter().enumerate() {
+        let (lo_nis, hi_nis) = (
+            chi_square(2.0 * runs as f64, -z),
+            chi_square(2.0 * runs as f64, z),
+        );
+        let (lo_nees, hi_nees) = (
+            chi_square(4.0 * runs as f64, -z),
+            chi_square(4.0 * runs as f64, z),
+        );
+        eprintln!(
+            "t = {} s: Σ NIS {:.1} in [{lo_nis:.1}, {hi_nis:.1}], Σ NEES {:.1} in [{lo_nees:.1}, {hi_nees:.1}]",
+            k as f64 * tau,
+            nis[j],
+            nees[j]
+        );
+        assert!(nis[j] > lo_nis && nis[j] < hi_nis, "NIS at {k}: {}", nis[j]);
+        assert!(
+            nees[j] > lo_nees && nees[j] < hi_nees,
+            "NEES at {k}: {}",
+            nees[j]
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Example 1 under noise
+
+/// Figures over `[2, 10]` s: all samples, and without the two samples that
+/// bracket each plant impact (the last before it, the first after it).
+struct Scored {
+    all: Figures,
+    clean: Figures,
+    /// Samples after each plant impact (past 2 s) until `|v − v̂| < 1e-2`.
+    recover: Vec<usize>,
+}
+
+fn score<const N: usize>(data: &Reference<N>, estimates: &[Estimate<f64, N>]) -> Scored {
+    let errors = errors(data, estimates);
+    let mut bracket = vec![false; errors.len()];
+    let mut recover = Vec::new();
+    for &(t, _, _) in &data.impacts {
+        let first = data
+            .samples
+            .iter()
+            .position(|s| s.t >= t - 1e-12)
+            .unwrap_or(errors.len());
+        if first < errors.len() {
+            bracket[first] = true;
+        }
+        if first > 0 {
+            bracket[first - 1] = true;
+        }
+        if t >= 2.0 {
+            let back = (first..errors.len())
+                .find(|&j| errors[j] < 1e-2)
+                .map_or(usize::MAX, |j| j - first);
+            recover.push(back);
+        }
+    }
+    let in_window = |s: &State<f64, N>| s.t >= 2.0 - 1e-9 && s.t < 10.0 + 1e-3 - 1e-9;
+    let all: Vec<f64> = data
+        .samples
+        .iter()
+        .zip(&errors)
+        .filter(|(s, _)| in_window(s))
+        .map(|(_, &e)| e)
+        .collect();
+    let clean: Vec<f64> = data
+        .samples
+        .iter()
+        .zip(&errors)
+        .zip(&bracket)
+        .filter(|((s, _), b)| in_window(s) && !**b)
+        .map(|((_, &e), _)| e)
+        .collect();
+    Scored {
+        all: figures(&all),
+        clean: figures(&clean),
+        recover,
+    }
+}
+
+/// The process noise for Example 1 picked by [`tune_process_noise`] from
+/// one recorded noisy run (the model file's initial state, its own noise
+/// seed), used unchanged on every other run.
+fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let data = reference(
+        &model,
+        Parabola::<f64>::initial_state(),
+        1e-5,
+        100,
+        10.0,
+        &u,
+    );
+    let measured = measure(&data, sigma, 1000);
+    let t: Vec<f64> = data.samples.iter().map(|s| s.t).collect();
+    let tuned = tune_process_noise::<_, _, 2, 2>(
+        &model,
+        KalmanParams::new(20.0, sigma),
+        &t,
+        &measured,
+        &Vector2::zeros(),
+        &u,
+        (-4.0, 2.0),
+    )
+    .unwrap();
+    eprintln!(
+        "tuned on one run: factor {:.3e}, q_a {:.3e}, log-likelihood {:.1}, {} runs",
+        tuned.factor, tuned.params.accel_noise[0], tuned.log_likelihood, tuned.evaluations
+    );
+    tuned.params
+}
+
+/// Example 1 on four initial states (the model file's, whose impacts
+/// accumulate at 4.456 s before it slides, and three more), `v̂(0) = 0`,
+/// 1 kHz samples of the plant at `τ = 1e-5`, scored over `[2, 10]` s; the
+/// process noise picked once by the likelihood helper from another noisy
+/// run. Asserted: with exact samples the median is at most 1e-8 (the
+/// issue's figure); with `σ = 1e-4` the filter's median and 90th
+/// percentile are below those of the reduced-order observer (38), told
+/// `σ`, on the same samples. (The noisy targets, median ≤ 3e-5 and
+/// 90th percentile ≤ 2e-4, are not reached: the figures are printed.)
+#[test]
+fn example_1_figures_beside_the_reduced_order_observer() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let params = tuned_example_1(1e-4);
+    for (n, start) in example_1_starts().into_iter().enumerate() {
+        let data = reference(&model, start, 1e-5, 100, 10.0, &u);
+        for sigma in [1e-4, 0.0] {
+            let measured = measure(&data, sigma, 11 + n as u64);
+            let params = KalmanParams {
+                measurement: SMatrix::identity() * sigma * sigma,
+                observer: ObserverParams {
+                    noise: sigma,
+                    ..params.observer
+                },
+                ..params
+            };
+            let mut f =
+                SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros())
+                    .unwrap();
+            let est = filter_run(&mut f, &model, &data, &measured, &u);
+            let sc = score(&data, &est);
+            let mut o = ReducedOrder::<f64, 2, 2>::new(
+                ObserverParams::new(10.0, 20.0).with_noise(sigma),
+                0.0,
+                measured[0],
+                Vector2::zeros(),
+            )
+            .unwrap();
+            let mut obs = vec![o.estimate()];
+            for (s, q) in data.samples.iter().zip(&measured).skip(1) {
+                obs.push(o.update(&model, s.t, q, &u).unwrap());
+            }
+            let so = score(&data, &obs);
+            eprintln!(
+                "Example 1, start {n}, σ = {sigma:e}: filter median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e}; samples to recover, worst {}), (38) median {:.2e} p90 {:.2e} max {:.2e}",
+                sc.all.median,
+                sc.all.p90,
+                sc.all.max,
+                sc.clean.max,
+                sc.recover.iter().max().unwrap_or(&0),
+                so.all.median,
+                so.all.p90,
+                so.all.max
+            );
+            eprintln!(
+                "  samples after each plant impact past 2 s until |v − v̂| < 1e-2: {:?}",
+                sc.recover
+            );
+            if sigma == 0.0 {
+                assert!(sc.all.median <= 1e-8, "start {n}: {:e}", sc.all.median);
+            } else {
+                assert!(
+                    sc.all.median < so.all.median && sc.all.p90 < so.all.p90,
+                    "start {n}"
+                );
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Numerical care, reproducibility, bad data
+
+/// The covariance as a dense matrix, checked symmetric (exactly: the
+/// update symmetrises it) and positive definite (Cholesky).
+fn assert_spd<const N: usize>(p: &Blocks<f64, N>, at: f64) {
+    let d = dense(p);
+    assert_eq!(d, d.transpose(), "P not symmetric at t = {at}");
+    assert!(
+        d.clone().cholesky().is_some(),
+        "P not positive definite at t = {at}: {d}"
+    );
+}
+
+/// 10⁵ updates (100 s of Example 1 at 1 kHz with σ = 1e-4: the
+/// accumulation, then sliding for 95 s): the covariance stays symmetric
+/// and positive definite after every update, and bounded.
+#[test]
+fn covariance_stays_symmetric_positive_definite_over_1e5_updates() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let data = reference(
+        &model,
+        Parabola::<f64>::initial_state(),
+        1e-5,
+        100,
+        100.0,
+        &u,
+    );
+    let measured = measure(&data, 1e-4, 5);
+    let params = KalmanParams::new(20.0, 1e-4);
+    let mut f =
+        SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
+    let mut largest: f64 = 0.0;
+    for (s, q) in data.samples.iter().zip(&measured).skip(1) {
+        f.update(&model, s.t, q, &u).unwrap();
+        assert_spd(f.covariance(), s.t);
+        largest = largest.max(f.covariance().trace());
+    }
+    assert_eq!(data.samples.len() - 1, 100_000);
+    eprintln!("10^5 updates: largest trace of P {largest:.2e}");
+    assert!(largest < 1e3);
+}
+
+fn bits(estimates: &[Estimate<f64, 2>]) -> Vec<u64> {
+    estimates
+        .iter()
+        .flat_map(|e| e.q.iter().chain(e.v.iter()).map(|x| x.to_bits()))
+        .collect()
+}
+
+/// The same measurements give the same bits, estimate and covariance.
+#[test]
+fn same_measurements_give_the_same_bits() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let data = reference(&model, Parabola::<f64>::initial_state(), 1e-5, 100, 6.0, &u);
+    let measured = measure(&data, 1e-4, 3);
+    let run = || {
+        let mut f = SaltationKalman::<f64, 2, 2>::new(
+            KalmanParams::new(20.0, 1e-4),
+            0.0,
+            measured[0],
+            Vector2::zeros(),
+        )
+        .unwrap();
+        let e = filter_run(&mut f, &model, &data, &measured, &u);
+        (bits(&e), *f.covariance())
+    };
+    let (a, pa) = run();
+    let (b, pb) = run();
+    assert_eq!(a, b);
+    assert_eq!(dense(&pa).map(f64::to_bits), dense(&pb).map(f64::to_bits));
+}
+
+/// Bad samples, inputs, parameters and settings are refused with an error
+/// naming the problem, and the filter's state is kept bit for bit; the
+/// next good sample goes on as if the bad one never came.
+#[test]
+fn bad_input_is_refused_and_the_state_kept() {
+    let mut model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let data = reference(&model, Parabola::<f64>::initial_state(), 1e-5, 100, 1.0, &u);
+    let measured = measure(&data, 1e-4, 9);
+    let mut f = SaltationKalman::<f64, 2, 2>::new(
+        KalmanParams::new(20.0, 1e-4),
+        0.0,
+        measured[0],
+        Vector2::zeros(),
+    )
+    .unwrap();
+    for (s, q) in data.samples.iter().zip(&measured).skip(1).take(500) {
+        f.update(&model, s.t, q, &u).unwrap();
+    }
+    let kept = f;
+    let t = data.samples[501].t;
+    let q = measured[501];
+    let same = |f: &SaltationKalman<f64, 2, 2>| assert!(*f == kept, "state changed");
+    assert!(matches!(
+        f.update(&model, t, &Vector2::new(f64::NAN, 1.0), &u),
+        Err(ObserverError::Data(DataError::NonFinite {
+            which: "q",
+            index: 0
+        }))
+    ));
+    same(&f);
+    assert!(matches!(
+        f.update(&model, kept.estimate().t, &q, &u),
+        Err(ObserverError::InvalidTime { .. })
+    ));
+    same(&f);
+    assert!(matches!(
+        f.update(&model, f64::INFINITY, &q, &u),
+        Err(ObserverError::InvalidTime { .. })
+    ));
+    same(&f);
+    let g = Parabola::<f64>::parameter_index("g").unwrap();
+    *model.parameter_mut(g).unwrap() = f64::NAN;
+    assert!(
+        matches!(f.update(&model, t, &q, &u), Err(ObserverError::Data(DataError::NonFiniteParameter { index })) if index == g)
+    );
+    same(&f);
+    *model.parameter_mut(g).unwrap() = 9.81;
+    // the next good sample: as if nothing had happened
+    let mut fresh = kept;
+    assert_eq!(
+        f.update(&model, t, &q, &u).unwrap(),
+        fresh.update(&model, t, &q, &u).unwrap()
+    );
+    // bad settings and initial data
+    let bad = |p: KalmanParams<f64, 2>| {
+        SaltationKalman::<f64, 2, 2>::new(p, 0.0, measured[0], Vector2::zeros()).unwrap_err()
+    };
+    let base = KalmanParams::<f64, 2>::new(20.0, 1e-4);
+    assert!(matches!(
+        bad(base.with_accel_noise(-1.0)),
+        ObserverError::Data(DataError::InvalidParams {
+            name: "accel_noise",
+            ..
+        })
+    ));
+    assert!(matches!(
+        bad(KalmanParams {
+            measurement: nalgebra::Matrix2::new(1.0, 0.5, 0.0, 1.0),
+            ..base
+        }),
+        ObserverError::Data(DataError::InvalidParams {
+            name: "measurement",
+            ..
+        })
+    ));
+    assert!(matches!(
+        bad(KalmanParams { gate: 0.0, ..base }),
+        ObserverError::Data(DataError::InvalidParams { name: "gate", .. })
+    ));
+    assert!(matches!(
+        bad(KalmanParams {
+            initial_velocity_sigma: f64::NAN,
+            ..base
+        }),
+        ObserverError::Data(DataError::InvalidParams {
+            name: "initial_velocity_sigma",
+            ..
+        })
+    ));
+    assert!(matches!(
+        bad(KalmanParams::new(-1.0, 1e-4)),
+        ObserverError::Data(DataError::InvalidParams {
+            name: "velocity_bound",
+            ..
+        })
+    ));
+    assert!(matches!(
+        SaltationKalman::<f64, 2, 2>::new(base, 0.0, Vector2::new(0.0, f64::NAN), Vector2::zeros()),
+        Err(ObserverError::Data(DataError::NonFinite {
+            which: "q0",
+            index: 1
+        }))
+    ));
+    let asymmetric = Blocks {
+        qv: nalgebra::Matrix2::new(1.0, 0.0, 0.0, 0.0),
+        ..Blocks::identity()
+    };
+    assert!(matches!(
+        SaltationKalman::<f64, 2, 2>::with_covariance(
+            base,
+            0.0,
+            measured[0],
+            Vector2::zeros(),
+            asymmetric
+        ),
+        Err(ObserverError::Data(DataError::InvalidParams {
+            name: "p0",
+            ..
+        }))
+    ));
+}
+
+/// A glitch (one sample 5 mm off, 50 σ) is reported as an outlier and
+/// skipped: the estimate after it is the prediction, which moves the
+/// velocity less than a twentieth of what absorbing the sample (the gate
+/// off) would; a run of consecutive outliers longer
+/// than `max_outliers` is taken as the model being wrong and followed.
+#[test]
+fn a_glitch_is_reported_and_skipped_not_absorbed() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    // free flight between 1.0 and 1.5 s? the model file's start is in
+    // flight from 0.66 s to 1.2 s
+    let data = reference(&model, Parabola::<f64>::initial_state(), 1e-5, 100, 1.2, &u);
+    let measured = measure(&data, 1e-4, 21);
+    let params = KalmanParams::new(20.0, 1e-4);
+    let run = |glitches: &[usize]| {
+        let mut f =
+            SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
+        let mut out = Vec::new();
+        for (k, (s, q)) in data.samples.iter().zip(&measured).enumerate().skip(1) {
+            let q = if glitches.contains(&k) {
+                q + Vector2::new(5e-3, 0.0)
+            } else {
+                *q
+            };
+            let e = f.update(&model, s.t, &q, &u).unwrap();
+            out.push((e, *f.kalman_report()));
+        }
+        out
+    };
+    let clean = run(&[]);
+    let glitched = run(&[1000]);
+    let (_, report) = glitched[999];
+    assert!(report.outlier && !report.inflated, "{report:?}");
+    assert!(report.nis > params.gate);
+    assert!(
+        clean.iter().all(|(_, r)| !r.outlier),
+        "no outlier in the clean run"
+    );
+    // what absorbing the glitch would have done: the same run with the gate off
+    let absorbed = {
+        let mut f = SaltationKalman::<f64, 2, 2>::new(
+            KalmanParams {
+                gate: f64::INFINITY,
+                ..params
+            },
+            0.0,
+            measured[0],
+            Vector2::zeros(),
+        )
+        .unwrap();
+        let mut v = Vector2::zeros();
+        for (k, (s, q)) in data
+            .samples
+            .iter()
+            .zip(&measured)
+            .enumerate()
+            .skip(1)
+            .take(1001)
+        {
+            let q = if k == 1000 {
+                q + Vector2::new(5e-3, 0.0)
+            } else {
+                *q
+            };
+            v = f.update(&model, s.t, &q, &u).unwrap().v;
+        }
+        v
+    };
+    let moved = (glitched[999].0.v - clean[999].0.v).norm();
+    let would_move = (absorbed - clean[999].0.v).norm();
+    eprintln!(
+        "glitch: NIS {:.1}; the estimate moved {moved:.2e} (absorbing it: {would_move:.2e})",
+        report.nis
+    );
+    assert!(moved < 0.05 * would_move);
+    // three in a row: the third is used, with the covariance inflated
+    let steps = run(&[1000, 1001, 1002]);
+    assert!(steps[999].1.outlier && steps[1000].1.outlier);
+    assert!(!steps[1001].1.outlier && steps[1001].1.inflated);
+}
+
+/// The filter in `f32` on Example 1 with σ = 1e-3 (a noise an `f32`
+/// position resolves): it runs through the impacts, the accumulation and
+/// sliding with a covariance symmetric and positive semi-definite to the
+/// round-off of `f32` (its smallest eigenvalue at least `−64 ε tr P`; a
+/// square-root form would be needed for strict definiteness at this
+/// conditioning), and its median error over [2, 10] s is below the
+/// reduced-order observer's in `f32` on the same samples.
+#[test]
+fn runs_in_f32() {
+    let model = Parabola::<f32>::new();
+    let model64 = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let data = reference(
+        &model64,
+        Parabola::<f64>::initial_state(),
+        1e-5,
+        100,
+        10.0,
+        &u,
+    );
+    let measured = measure(&data, 1e-3, 17);
+    let q32: Vec<SVector<f32, 2>> = measured.iter().map(|q| q.cast::<f32>()).collect();
+    let mut f = SaltationKalman::<f32, 2, 2>::new(
+        KalmanParams::new(20.0, 1e-3),
+        0.0,
+        q32[0],
+        SVector::zeros(),
+    )
+    .unwrap();
+    let mut o = ReducedOrder::<f32, 2, 2>::new(
+        ObserverParams::new(10.0, 20.0).with_noise(1e-3),
+        0.0,
+        q32[0],
+        SVector::zeros(),
+    )
+    .unwrap();
+    let (mut ef, mut eo) = (Vec::new(), Vec::new());
+    for (s, q) in data.samples.iter().zip(&q32).skip(1) {
+        let a = f.update(&model, s.t as f32, q, &SVector::zeros()).unwrap();
+        let b = o.update(&model, s.t as f32, q, &SVector::zeros()).unwrap();
+        // symmetric, and positive semi-definite to the round-off of f32
+        let p = dense(&Blocks {
+            qq: f.covariance().qq.cast(),
+            qv: f.covariance().qv.cast(),
+            vq: f.covariance().vq.cast(),
+            vv: f.covariance().vv.cast(),
+        });
+        assert_eq!(p, p.transpose());
+        let min = p.symmetric_eigenvalues().min();
+        assert!(
+            min >= -64.0 * f64::from(f32::EPSILON) * p.trace(),
+            "t = {}: {min:e}",
+            s.t
+        );
+        if s.t >= 2.0 {
+            ef.push((a.v.cast::<f64>() - s.v).norm());
+            eo.push((b.v.cast::<f64>() - s.v).norm());
+        }
+    }
+    let (ff, fo) = (figures(&ef), figures(&eo));
+    eprintln!(
+        "f32, σ = 1e-3: filter median {:.2e} p90 {:.2e}; (38) median {:.2e} p90 {:.2e}",
+        ff.median, ff.p90, fo.median, fo.p90
+    );
+    assert!(ff.median < fo.median);
+}

@@ -1,0 +1,3 @@
+moreau::model!(file = "tests/ui/yaml/parens.yaml");
+
+fn main() {}
