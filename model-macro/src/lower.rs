@@ -36,28 +36,7 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
     };
     // The tree first: its fields name only parameters, and definitions and
     // constraints may name its bodies' points.
-    let mut fields = Vec::with_capacity(model.bodies.len());
-    for body in &model.bodies {
-        fields.push(tree::BodyFields {
-            xyz: b.three(&body.xyz)?,
-            rpy: b.three(&body.rpy)?,
-            mass: b.expr(&body.mass)?,
-            com: b.three(&body.com)?,
-            inertia: [
-                b.expr(&body.inertia[0])?,
-                b.expr(&body.inertia[1])?,
-                b.expr(&body.inertia[2])?,
-                b.expr(&body.inertia[3])?,
-                b.expr(&body.inertia[4])?,
-                b.expr(&body.inertia[5])?,
-            ],
-        });
-    }
-    let gravity = b.three(&model.gravity)?;
-    let built = tree::build(&mut b.graph, layout, &model.bodies, &fields, gravity);
-    for (body, pose) in model.bodies.iter().zip(&built.poses) {
-        b.poses[body.index] = Some(*pose);
-    }
+    let built = b.tree(model)?;
     for d in &model.definitions {
         let id = b.expr(d)?;
         b.definitions.push(id);
@@ -83,21 +62,7 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
             None => b.graph.constant(0.0),
         });
     }
-    let mut gaps = Vec::with_capacity(model.k());
-    for (h, c) in model.gaps.iter().zip(&model.spec.constraints) {
-        let id = b.expr(h)?;
-        // A gap that does not move with the configuration constrains nothing
-        // (`0 >= 1` is always violated or always satisfied).
-        let moves = (0..layout.n).any(|i| b.graph.depends_on(id, layout.id(Var::Coordinate(i))));
-        if !moves {
-            cx.error(
-                h.loc,
-                format!("constraint `{}` does not depend on any coordinate: it can never be reached or left", c.name.text),
-            );
-            return None;
-        }
-        gaps.push(id);
-    }
+    let gaps = b.gaps(model)?;
     let q: Vec<VarId> = (0..layout.n)
         .map(|i| layout.id(Var::Coordinate(i)))
         .collect();
@@ -240,6 +205,62 @@ struct Builder<'a> {
 impl Builder<'_> {
     fn three(&mut self, e: &[Expr<Symbol>; 3]) -> Option<[Id; 3]> {
         Some([self.expr(&e[0])?, self.expr(&e[1])?, self.expr(&e[2])?])
+    }
+
+    /// The kinematic tree's T, V and body poses, its fields built first.
+    fn tree(&mut self, model: &Resolved<'_>) -> Option<tree::Tree> {
+        let mut fields = Vec::with_capacity(model.bodies.len());
+        for body in &model.bodies {
+            fields.push(tree::BodyFields {
+                xyz: self.three(&body.xyz)?,
+                rpy: self.three(&body.rpy)?,
+                mass: self.expr(&body.mass)?,
+                com: self.three(&body.com)?,
+                inertia: [
+                    self.expr(&body.inertia[0])?,
+                    self.expr(&body.inertia[1])?,
+                    self.expr(&body.inertia[2])?,
+                    self.expr(&body.inertia[3])?,
+                    self.expr(&body.inertia[4])?,
+                    self.expr(&body.inertia[5])?,
+                ],
+            });
+        }
+        let gravity = self.three(&model.gravity)?;
+        let built = tree::build(
+            &mut self.graph,
+            self.layout,
+            &model.bodies,
+            &fields,
+            gravity,
+        );
+        for (body, pose) in model.bodies.iter().zip(&built.poses) {
+            self.poses[body.index] = Some(*pose);
+        }
+        Some(built)
+    }
+
+    /// The gaps, each of which must move with the configuration.
+    fn gaps(&mut self, model: &Resolved<'_>) -> Option<Vec<Id>> {
+        let mut gaps = Vec::with_capacity(model.k());
+        for (h, c) in model.gaps.iter().zip(&model.spec.constraints) {
+            let id = self.expr(h)?;
+            // A gap that does not move with the configuration constrains nothing
+            // (`0 >= 1` is always violated or always satisfied).
+            let moves = (0..self.layout.n).any(|i| {
+                self.graph
+                    .depends_on(id, self.layout.id(Var::Coordinate(i)))
+            });
+            if !moves {
+                self.cx.error(
+                    h.loc,
+                    format!("constraint `{}` does not depend on any coordinate: it can never be reached or left", c.name.text),
+                );
+                return None;
+            }
+            gaps.push(id);
+        }
+        Some(gaps)
     }
 
     /// The node of `e`; `None` after reporting a subexpression that folds

@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use crate::expr::fmt_number;
 use crate::keys;
-use crate::spec::{JointKind, ModelSpec, Origin};
+use crate::spec::{Body, JointKind, ModelSpec, Origin};
 
 /// The model's text in the YAML language.
 pub(crate) fn source(spec: &ModelSpec) -> String {
@@ -69,42 +69,7 @@ fn canonical(spec: &ModelSpec) -> String {
         let _ = writeln!(s, "{}:", keys::BODIES);
     }
     for b in &spec.bodies {
-        let j = &b.joint;
-        let _ = writeln!(s, "  - {}: {}", keys::NAME, b.name.text);
-        if let Some(p) = &b.parent {
-            let _ = writeln!(s, "    {}: {}", keys::PARENT, p.text);
-        }
-        let kind = match j.kind {
-            JointKind::Revolute => "revolute",
-            JointKind::Prismatic => "prismatic",
-            JointKind::Fixed => "fixed",
-        };
-        let _ = write!(s, "    {}: {{{}: {kind}", keys::JOINT, keys::TYPE);
-        if let Some(i) = j.coordinate {
-            let c = &spec.coordinates[i];
-            let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
-            let _ = write!(
-                s,
-                ", {}: {}, {}: {}, {}: [{}]",
-                keys::NAME,
-                c.q.text,
-                keys::VELOCITY,
-                c.v.text,
-                keys::AXIS,
-                axis.join(", ")
-            );
-        }
-        let _ = writeln!(
-            s,
-            ", {}: {}, {}: {}}}",
-            keys::XYZ,
-            list(&j.xyz),
-            keys::RPY,
-            list(&j.rpy)
-        );
-        let _ = writeln!(s, "    {}: \"{}\"", keys::MASS, b.mass);
-        let _ = writeln!(s, "    {}: {}", keys::COM, list(&b.com));
-        let _ = writeln!(s, "    {}: {}", keys::INERTIA, list(&b.inertia));
+        body(&mut s, spec, b);
     }
     if let Some(k) = &spec.kinetic {
         let _ = writeln!(s, "{}: \"{k}\"", keys::KINETIC);
@@ -144,6 +109,46 @@ fn canonical(spec: &ModelSpec) -> String {
 fn list(items: &[crate::expr::Expr]) -> String {
     let quoted: Vec<String> = items.iter().map(|e| format!("\"{e}\"")).collect();
     format!("[{}]", quoted.join(", "))
+}
+
+/// One body of the tree, as a YAML list entry.
+fn body(s: &mut String, spec: &ModelSpec, b: &Body) {
+    let j = &b.joint;
+    let _ = writeln!(s, "  - {}: {}", keys::NAME, b.name.text);
+    if let Some(p) = &b.parent {
+        let _ = writeln!(s, "    {}: {}", keys::PARENT, p.text);
+    }
+    let kind = match j.kind {
+        JointKind::Revolute => "revolute",
+        JointKind::Prismatic => "prismatic",
+        JointKind::Fixed => "fixed",
+    };
+    let _ = write!(s, "    {}: {{{}: {kind}", keys::JOINT, keys::TYPE);
+    if let Some(i) = j.coordinate {
+        let c = &spec.coordinates[i];
+        let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
+        let _ = write!(
+            s,
+            ", {}: {}, {}: {}, {}: [{}]",
+            keys::NAME,
+            c.q.text,
+            keys::VELOCITY,
+            c.v.text,
+            keys::AXIS,
+            axis.join(", ")
+        );
+    }
+    let _ = writeln!(
+        s,
+        ", {}: {}, {}: {}}}",
+        keys::XYZ,
+        list(&j.xyz),
+        keys::RPY,
+        list(&j.rpy)
+    );
+    let _ = writeln!(s, "    {}: \"{}\"", keys::MASS, b.mass);
+    let _ = writeln!(s, "    {}: {}", keys::COM, list(&b.com));
+    let _ = writeln!(s, "    {}: {}", keys::INERTIA, list(&b.inertia));
 }
 
 #[cfg(test)]

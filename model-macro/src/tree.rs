@@ -131,32 +131,40 @@ pub(crate) fn build(
             }
             JointKind::Fixed => {}
         }
-        // Energies.
-        let com_world = mat_vec(g, &r, f.com);
-        let c = add(g, p, com_world);
-        let spin = cross(g, w, com_world);
-        let vc = add(g, v, spin);
-        let omega = mat_t_vec(g, &r, w);
-        let [ixx, ixy, ixz, iyy, iyz, izz] = f.inertia;
-        let inertia = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]];
-        let i_omega = mat_vec(g, &inertia, omega);
-        let rot = dot(g, omega, i_omega);
-        let lin = dot(g, vc, vc);
-        let lin = g.mul(f.mass, lin);
-        let twice = g.add(lin, rot);
-        let half = g.constant(0.5);
-        let t = g.mul(half, twice);
+        let pose = Pose { r, p, w, v };
+        let (t, work) = energies(g, &pose, f, gravity);
         kinetic = g.add(kinetic, t);
-        let height = dot(g, gravity, c);
-        let work = g.mul(f.mass, height);
         potential = g.sub(potential, work);
-        poses.push(Pose { r, p, w, v });
+        poses.push(pose);
     }
     Tree {
         poses,
         kinetic,
         potential,
     }
+}
+
+/// One body's kinetic energy `½ (m |v_c|² + Ωᵀ I Ω)` (`Ω = Rᵀω` in the
+/// body frame) and its potential energy's opposite `m gᵀ c`, at `pose`.
+fn energies(g: &mut Graph, pose: &Pose, f: &BodyFields, gravity: V3) -> (Id, Id) {
+    let Pose { r, p, w, v } = *pose;
+    let com_world = mat_vec(g, &r, f.com);
+    let c = add(g, p, com_world);
+    let spin = cross(g, w, com_world);
+    let vc = add(g, v, spin);
+    let omega = mat_t_vec(g, &r, w);
+    let [ixx, ixy, ixz, iyy, iyz, izz] = f.inertia;
+    let inertia = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]];
+    let i_omega = mat_vec(g, &inertia, omega);
+    let rot = dot(g, omega, i_omega);
+    let lin = dot(g, vc, vc);
+    let lin = g.mul(f.mass, lin);
+    let twice = g.add(lin, rot);
+    let half = g.constant(0.5);
+    let t = g.mul(half, twice);
+    let height = dot(g, gravity, c);
+    let work = g.mul(f.mass, height);
+    (t, work)
 }
 
 /// The world position of the point `local` of a body at `pose`.

@@ -118,6 +118,23 @@ pub(crate) fn import(
             _ => {}
         }
     }
+    let root = check_tree(display, &links, &joints, locked, &mut errors);
+    match root {
+        Some(root) if errors.is_empty() => walk(display, &links, &joints, root, loc),
+        _ => Err(errors),
+    }
+}
+
+/// Checks that the joints make one tree over the links (every link named
+/// exists, each link the child of at most one joint, one root) and that
+/// every locked joint exists; the root link, or `None` with `errors`.
+fn check_tree<'a>(
+    display: &str,
+    links: &[(&'a str, Inertial)],
+    joints: &[UrdfJoint<'a>],
+    locked: &[Name],
+    errors: &mut Vec<String>,
+) -> Option<&'a str> {
     for l in locked {
         if !joints.iter().any(|j| j.name == l.text) {
             errors.push(format!(
@@ -156,9 +173,19 @@ pub(crate) fn import(
             roots.join(", ")
         ));
     }
-    if !errors.is_empty() {
-        return Err(errors);
-    }
+    (roots.len() == 1).then(|| roots[0])
+}
+
+/// Reads the tree depth-first from `root`, children in the order of the
+/// file, into bodies, coordinates and limits.
+fn walk(
+    display: &str,
+    links: &[(&str, Inertial)],
+    joints: &[UrdfJoint<'_>],
+    root: &str,
+    loc: Loc,
+) -> Result<Imported, Vec<String>> {
+    let inertials: HashMap<&str, Inertial> = links.iter().copied().collect();
     // Depth-first from the root, children in the order of the file.
     let mut imported = Imported {
         bodies: Vec::new(),
@@ -169,7 +196,7 @@ pub(crate) fn import(
         .iter()
         .enumerate()
         .rev()
-        .filter(|(_, j)| j.parent == roots[0])
+        .filter(|(_, j)| j.parent == root)
         .map(|(i, _)| (i, None))
         .collect();
     let number = |value: f64| Expr {

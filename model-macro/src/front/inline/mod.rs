@@ -19,6 +19,9 @@
 //!
 //! The body is cut into items by hand (a brace group, or everything up to
 //! `;`), so one malformed item is reported and the others are still read.
+//! The kinematic tree (`bodies`, `gravity`) is read in `bodies.rs`.
+
+mod bodies;
 
 use proc_macro2::{Delimiter, Group, Spacing, Span, TokenStream, TokenTree};
 
@@ -182,59 +185,21 @@ fn read_keyed(cx: &Ctxt, spec: &mut ModelSpec, key_text: &str, loc: Loc, rest: &
             written.append(&mut spec.coordinates);
             spec.coordinates = written;
         }
-        (keys::BODIES, [TokenTree::Group(g)]) => {
-            spec.bodies_loc = Some(loc);
-            for e in entries(cx, g) {
-                if let Some(body) = body(cx, spec, e) {
-                    spec.bodies.push(body);
-                }
-            }
-        }
+        (keys::BODIES, [TokenTree::Group(g)]) => bodies::bodies(cx, spec, g, loc),
         (keys::GRAVITY, [eq, TokenTree::Group(g)]) if is_punct(eq, '=') => {
-            spec.gravity = vector::<3>(cx, g, loc, "`gravity`");
+            spec.gravity = bodies::vector::<3>(cx, g, loc, "`gravity`");
         }
         (keys::GRAVITY, _) => cx.error(loc, "expected `gravity = [x, y, z];`"),
-        (keys::PARAMETERS, [TokenTree::Group(g)]) => {
-            spec.parameters = entries(cx, g)
-                .into_iter()
-                .filter_map(|e| {
-                    let default = e.number(cx)?;
-                    Some(Parameter {
-                        doc: e.doc,
-                        name: e.name,
-                        default,
-                    })
-                })
-                .collect();
-        }
+        (keys::PARAMETERS, [TokenTree::Group(g)]) => spec.parameters = parameters(cx, g),
         (keys::INPUTS, [TokenTree::Group(g)]) => spec.inputs = inputs(cx, g),
-        (keys::APPLIED, [TokenTree::Group(g)]) => {
-            spec.applied = entries(cx, g)
-                .into_iter()
-                .filter_map(|e| {
-                    let expr = e.expr(cx)?;
-                    Some(Applied {
-                        coordinate: e.name,
-                        expr,
-                    })
-                })
-                .collect();
-        }
+        (keys::APPLIED, [TokenTree::Group(g)]) => spec.applied = applied(cx, g),
         (keys::CONSTRAINTS, [TokenTree::Group(g)]) => {
             spec.constraints = entries(cx, g)
                 .into_iter()
                 .filter_map(|e| constraint(cx, e))
                 .collect();
         }
-        (keys::INITIAL, [TokenTree::Group(g)]) => {
-            spec.initial = entries(cx, g)
-                .into_iter()
-                .filter_map(|e| {
-                    let x = e.number(cx)?;
-                    Some((e.name, x))
-                })
-                .collect();
-        }
+        (keys::INITIAL, [TokenTree::Group(g)]) => spec.initial = initial(cx, g),
         (keys::KINETIC, rest) => spec.kinetic = assigned_expr(cx, rest, loc, keys::KINETIC),
         (keys::POTENTIAL, rest) => spec.potential = assigned_expr(cx, rest, loc, keys::POTENTIAL),
         (keys::RESTITUTION, [eq, value @ ..]) if is_punct(eq, '=') => {
@@ -261,171 +226,44 @@ fn read_keyed(cx: &Ctxt, spec: &mut ModelSpec, key_text: &str, loc: Loc, rest: &
     }
 }
 
-/// `[a, b, c]`: `K` expressions in brackets.
-fn vector<const K: usize>(cx: &Ctxt, g: &Group, loc: Loc, what: &str) -> Option<[Expr; K]> {
-    let parts = split_commas(g.stream());
-    if g.delimiter() != Delimiter::Bracket || parts.len() != K {
-        cx.error(
-            Loc::span(g.span()),
-            format!("expected {K} expressions in brackets, `[..]`, for {what}"),
-        );
-        return None;
-    }
-    let all: Vec<Option<Expr>> = parts.iter().map(|p| expression(cx, p, loc)).collect();
-    let all: Vec<Expr> = all.into_iter().collect::<Option<_>>()?;
-    <[Expr; K]>::try_from(all).ok()
+/// `parameters { m: 1.0, ... }`, each with its doc comments.
+fn parameters(cx: &Ctxt, g: &Group) -> Vec<Parameter> {
+    entries(cx, g)
+        .into_iter()
+        .filter_map(|e| {
+            let default = e.number(cx)?;
+            Some(Parameter {
+                doc: e.doc,
+                name: e.name,
+                default,
+            })
+        })
+        .collect()
 }
 
-/// One body: `name: { parent: p, joint: revolute(q: v), axis: [..], xyz:
-/// [..], rpy: [..], mass: m, com: [..], inertia: [..] }` (the inline form
-/// of a YAML body, its joint's keys beside the body's). A moving joint
-/// appends its coordinate to `spec.coordinates`.
-fn body(cx: &Ctxt, spec: &mut ModelSpec, e: Entry) -> Option<Body> {
-    let here = Loc::span(e.colon);
-    let [TokenTree::Group(g)] = e.value.as_slice() else {
-        cx.error(
-            here,
-            format!(
-                "expected `{}: {{ joint: ..., mass: ..., ... }}`",
-                e.name.text
-            ),
-        );
-        return None;
-    };
-    let zero = || Expr {
-        kind: ExprKind::Num(0.0),
-        loc: here,
-    };
-    let (mut parent, mut joint, mut axis, mut mass) = (None, None, None, None);
-    let (mut xyz, mut rpy, mut com, mut inertia) = (None, None, None, None);
-    for f in entries(cx, g) {
-        let at = Loc::span(f.colon);
-        let group = match f.value.as_slice() {
-            [TokenTree::Group(g)] => Some(g),
-            _ => None,
-        };
-        match (f.name.text.as_str(), group) {
-            (keys::PARENT, _) => parent = f.single_name(cx, "the parent body's name (or `world`)"),
-            (keys::JOINT, _) => joint = Some((joint_kind(cx, &f)?, f.value.clone(), at)),
-            (keys::AXIS, Some(g)) => {
-                let parts = split_commas(g.stream());
-                let numbers: Vec<Option<Number>> = parts.iter().map(|p| number(cx, p, at)).collect();
-                let numbers: Option<Vec<Number>> = numbers.into_iter().collect();
-                axis = numbers.and_then(|n| <[Number; 3]>::try_from(n).ok());
-                let norm = axis.map_or(0.0, |a| a.iter().map(|n| n.value * n.value).sum::<f64>());
-                if !(norm.is_finite() && norm > 0.0) {
-                    cx.error(at, "a joint's axis is three numbers, finite and not all zero");
-                    return None;
-                }
-            }
-            (keys::XYZ, Some(g)) => xyz = vector::<3>(cx, g, at, "`xyz`"),
-            (keys::RPY, Some(g)) => rpy = vector::<3>(cx, g, at, "`rpy`"),
-            (keys::COM, Some(g)) => com = vector::<3>(cx, g, at, "`com`"),
-            (keys::INERTIA, Some(g)) => inertia = vector::<6>(cx, g, at, "`inertia` (ixx, ixy, ixz, iyy, iyz, izz)"),
-            (keys::MASS, _) => mass = f.expr(cx),
-            (other, _) => cx.error(
-                f.name.loc,
-                format!("unknown or malformed `{other}` in a body; a body has parent, joint, axis, xyz, rpy, mass, com, inertia"),
-            ),
-        }
-    }
-    let Some((kind, tokens, at)) = joint else {
-        cx.error(here, format!("missing `joint` in body `{}`", e.name.text));
-        return None;
-    };
-    let Some(mass) = mass else {
-        cx.error(here, format!("missing `mass` in body `{}`", e.name.text));
-        return None;
-    };
-    let coordinate = match (kind, tokens.as_slice()) {
-        (JointKind::Fixed, [_]) => None,
-        (JointKind::Fixed, _) => {
-            cx.error(at, "a fixed joint has no coordinate: write `joint: fixed`");
-            return None;
-        }
-        (_, [_, TokenTree::Group(args)]) => {
-            let mut names = entries_or_name(cx, args)?;
-            let q = names.remove(0);
-            let v = names.pop().unwrap_or_else(|| Name {
-                text: format!("d{}", q.text),
-                loc: q.loc,
-            });
-            spec.coordinates.push(Coordinate { q, v });
-            Some(spec.coordinates.len() - 1)
-        }
-        _ => {
-            cx.error(
-                at,
-                "a moving joint names its coordinate: `revolute(q)` or `revolute(q: dq)`",
-            );
-            return None;
-        }
-    };
-    let axis = match (kind, axis) {
-        (JointKind::Fixed, _) => [0.0, 0.0, 1.0].map(|value| Number { value, loc: here }),
-        (_, Some(a)) => a,
-        (_, None) => {
-            cx.error(here, format!("missing `axis` in body `{}`", e.name.text));
-            return None;
-        }
-    };
-    Some(Body {
-        name: e.name,
-        parent: parent.filter(|p| p.text != keys::WORLD),
-        joint: Joint {
-            kind,
-            coordinate,
-            axis,
-            xyz: xyz.unwrap_or_else(|| [zero(), zero(), zero()]),
-            rpy: rpy.unwrap_or_else(|| [zero(), zero(), zero()]),
-        },
-        mass,
-        com: com.unwrap_or_else(|| [zero(), zero(), zero()]),
-        inertia: inertia.unwrap_or_else(|| std::array::from_fn(|_| zero())),
-    })
+/// `applied { q: expr, ... }`.
+fn applied(cx: &Ctxt, g: &Group) -> Vec<Applied> {
+    entries(cx, g)
+        .into_iter()
+        .filter_map(|e| {
+            let expr = e.expr(cx)?;
+            Some(Applied {
+                coordinate: e.name,
+                expr,
+            })
+        })
+        .collect()
 }
 
-/// The kind of `joint: revolute(...)`, `prismatic(...)` or `fixed`.
-fn joint_kind(cx: &Ctxt, f: &Entry) -> Option<JointKind> {
-    match f.value.first() {
-        Some(TokenTree::Ident(i)) if i == "revolute" => Some(JointKind::Revolute),
-        Some(TokenTree::Ident(i)) if i == "prismatic" => Some(JointKind::Prismatic),
-        Some(TokenTree::Ident(i)) if i == "fixed" => Some(JointKind::Fixed),
-        _ => {
-            cx.error(
-                Loc::span(f.colon),
-                format!(
-                    "expected a joint ({}), as in `revolute(q: dq)`",
-                    keys::JOINT_TYPES.join(", ")
-                ),
-            );
-            None
-        }
-    }
-}
-
-/// `(q)` or `(q: dq)`: the coordinate's name, then the velocity's if given.
-fn entries_or_name(cx: &Ctxt, args: &Group) -> Option<Vec<Name>> {
-    let name = |t: &TokenTree| match t {
-        TokenTree::Ident(i) => Some(Name {
-            text: i.to_string(),
-            loc: Loc::span(i.span()),
-        }),
-        _ => None,
-    };
-    let trees: Vec<TokenTree> = args.stream().into_iter().collect();
-    let names = match trees.as_slice() {
-        [q] => name(q).map(|q| vec![q]),
-        [q, colon, v] if is_punct(colon, ':') => name(q).zip(name(v)).map(|(q, v)| vec![q, v]),
-        _ => None,
-    };
-    if names.is_none() {
-        cx.error(
-            Loc::span(args.span()),
-            "expected the joint's coordinate, `(q)`, or coordinate and velocity, `(q: dq)`",
-        );
-    }
-    names
+/// `initial { q: 1.0, ... }`.
+fn initial(cx: &Ctxt, g: &Group) -> Vec<(Name, Number)> {
+    entries(cx, g)
+        .into_iter()
+        .filter_map(|e| {
+            let x = e.number(cx)?;
+            Some((e.name, x))
+        })
+        .collect()
 }
 
 /// `inputs { u1, u2 }`: names only.
