@@ -12,113 +12,14 @@ use moreau::{
     ModelBounds, MoreauJean, Observer, ObserverError, ObserverParams, ReducedOrder, Restart, State,
     StepParams,
 };
+mod common;
+
+use common::runs::{Figures, Reference, errors, figures, measure, reference};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
 // ---------------------------------------------------------------------------
 // Reference data
-
-/// A plant trajectory sampled for an observer.
-struct Reference<const N: usize> {
-    /// The plant state at each sample time `t_j = j τ_s`.
-    samples: Vec<State<f64, N>>,
-    /// Plant impacts: (time, constraint, normal approach speed) for every
-    /// plant step whose LCP gave an impulse to a constraint approaching
-    /// faster than `min_impact_speed` (slower ones are resting contact).
-    impacts: Vec<(f64, usize, f64)>,
-}
-
-/// Runs the plant from `(q0, v0)` at step `tau` for `t_end` and keeps every
-/// `every`-th state.
-fn reference<M, const N: usize, const K: usize>(
-    model: &M,
-    (q0, v0): (SVector<f64, N>, SVector<f64, N>),
-    tau: f64,
-    every: usize,
-    t_end: f64,
-    u: &M::Input,
-) -> Reference<N>
-where
-    M: Model<N, K, Scalar = f64>,
-{
-    let min_impact_speed = 1e-2;
-    assert!(
-        model.gaps(&q0).iter().all(|&h| h >= 0.0),
-        "infeasible start {q0}"
-    );
-    let stepper = MoreauJean::new(StepParams::new(tau)).unwrap();
-    let mut state = State::new(0.0, q0, v0);
-    let mut samples = vec![state];
-    let mut impacts = Vec::new();
-    let steps = (t_end / tau).round() as usize;
-    for k in 1..=steps {
-        let before = state;
-        let report = stepper.step(model, &mut state, u).unwrap();
-        let jac = model.gap_jacobian(&before.q);
-        for i in report.impacting() {
-            let approach = -jac.row(i).dot(&before.v.transpose());
-            if approach > min_impact_speed {
-                impacts.push((state.t, i, approach));
-            }
-        }
-        if k % every == 0 {
-            // the stepper keeps t on its grid kτ: no round-off to correct
-            samples.push(state);
-        }
-    }
-    Reference { samples, impacts }
-}
-
-/// A tiny deterministic Gaussian generator: xorshift64* and Box–Muller.
-struct Gauss {
-    state: u64,
-    spare: Option<f64>,
-}
-
-impl Gauss {
-    fn new(seed: u64) -> Self {
-        Self {
-            state: seed.max(1),
-            spare: None,
-        }
-    }
-
-    /// Uniform in (0, 1].
-    fn uniform(&mut self) -> f64 {
-        self.state ^= self.state >> 12;
-        self.state ^= self.state << 25;
-        self.state ^= self.state >> 27;
-        let x = self.state.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        ((x >> 11) as f64 + 1.0) / (1u64 << 53) as f64
-    }
-
-    /// Standard normal.
-    fn normal(&mut self) -> f64 {
-        if let Some(z) = self.spare.take() {
-            return z;
-        }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let r = (-2.0 * u1.ln()).sqrt();
-        let angle = 2.0 * std::f64::consts::PI * u2;
-        self.spare = Some(r * angle.sin());
-        r * angle.cos()
-    }
-}
-
-/// The measured positions: the plant's, plus Gaussian noise of standard
-/// deviation `sigma` on each coordinate (none for `sigma = 0`).
-fn measure<const N: usize>(
-    reference: &Reference<N>,
-    sigma: f64,
-    seed: u64,
-) -> Vec<SVector<f64, N>> {
-    let mut gauss = Gauss::new(seed);
-    reference
-        .samples
-        .iter()
-        .map(|s| s.q + SVector::from_fn(|_, _| sigma * gauss.normal()))
-        .collect()
-}
 
 /// Feeds the measurements (from the second on) to `observer` and returns
 /// the estimates, the initial one first.
@@ -140,16 +41,6 @@ where
     estimates
 }
 
-/// `|v − v̂|` at every sample.
-fn errors<const N: usize>(reference: &Reference<N>, estimates: &[Estimate<f64, N>]) -> Vec<f64> {
-    reference
-        .samples
-        .iter()
-        .zip(estimates)
-        .map(|(s, e)| (s.v - e.v).norm())
-        .collect()
-}
-
 /// The errors at sample times in `[from, to)`.
 fn window<const N: usize>(
     reference: &Reference<N>,
@@ -164,25 +55,6 @@ fn window<const N: usize>(
         .filter(|(s, _)| s.t >= from - 1e-9 && s.t < to - 1e-9)
         .map(|(_, &e)| e)
         .collect()
-}
-
-/// Median, 90th percentile and maximum.
-#[derive(Clone, Copy, Debug)]
-struct Figures {
-    median: f64,
-    p90: f64,
-    max: f64,
-}
-
-fn figures(errors: &[f64]) -> Figures {
-    let mut sorted = errors.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let n = sorted.len();
-    Figures {
-        median: sorted[n / 2],
-        p90: sorted[(n * 9) / 10],
-        max: sorted[n - 1],
-    }
 }
 
 fn reduced<const N: usize, const K: usize>(

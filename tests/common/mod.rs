@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod runs;
+
 use std::path::PathBuf;
 
 use nalgebra::{DMatrix, SMatrix, SVector};
