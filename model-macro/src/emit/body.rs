@@ -9,6 +9,8 @@
 //! it holds (the output entry it is, a function of one variable, or an
 //! anonymous `a7`).
 
+use std::collections::HashMap;
+
 use moreau_sym::{Func, Layout, Op, Operand, Schedule, VarId};
 
 use super::names::{Local, Names, Role};
@@ -125,6 +127,7 @@ pub(crate) fn build(
         vars: model.layout,
         names: Names::new(model),
         constants: Vec::new(),
+        constant_index: HashMap::new(),
         codes: Vec::with_capacity(sched.instrs.len()),
         lets: Vec::new(),
         temps: 0,
@@ -201,6 +204,8 @@ struct Builder<'a, 'm> {
     vars: VarLayout,
     names: Names,
     constants: Vec<f64>,
+    /// The index of each constant in `constants`, by its bits.
+    constant_index: HashMap<u64, usize>,
     /// The code of each instruction so far: folded (taken by its one
     /// consumer, so that a long chain is moved, never copied), or its bound
     /// local.
@@ -223,21 +228,16 @@ impl Builder<'_, '_> {
     }
 
     fn constant(&mut self, c: f64) -> Local {
-        let i = match self
-            .constants
-            .iter()
-            .position(|x| x.to_bits() == c.to_bits())
-        {
-            Some(i) => i,
-            None => {
-                self.constants.push(c);
-                let local = Local::Const(self.constants.len() - 1);
-                let readable = local.readable(self.model, c);
-                self.names.declare(local, readable);
-                self.constants.len() - 1
-            }
-        };
-        Local::Const(i)
+        if let Some(&i) = self.constant_index.get(&c.to_bits()) {
+            return Local::Const(i);
+        }
+        let i = self.constants.len();
+        self.constants.push(c);
+        self.constant_index.insert(c.to_bits(), i);
+        let local = Local::Const(i);
+        let readable = local.readable(self.model, c);
+        self.names.declare(local, readable);
+        local
     }
 
     /// Binds `code` to `local` and returns the code that reads it.

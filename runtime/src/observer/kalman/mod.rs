@@ -333,6 +333,8 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     outliers: u32,
     report: UpdateReport<T, N, K>,
     kalman: KalmanReport<T>,
+    /// The observers' memos (injection gain, a constant `M`'s factor).
+    cache: Cache<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
@@ -404,6 +406,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             outliers: 0,
             report: UpdateReport::new(t0, T::zero()),
             kalman: KalmanReport::empty(),
+            cache: Cache::default(),
         })
     }
 
@@ -490,8 +493,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             restitution: self.restitution,
             report: &self.report,
         };
-        let (mut interval, mut report) =
-            Interval::begin(model, u, memory, &mut Cache::default(), t, q)?;
+        let (mut interval, mut report) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         let sigma = rule.noise;
         interval.gain = if sigma > T::zero() {
             sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
