@@ -10,7 +10,7 @@
 
 mod support;
 
-use moreau::{KalmanParams, MoreauJean, SaltationKalman, State, StepParams};
+use moreau::{KalmanParams, MoreauJean, Observer, SaltationKalman, State, StepParams};
 use moreau_models::Parabola;
 use nalgebra::{SVector, Vector2};
 use support::reference::Gaussian;

@@ -20,8 +20,8 @@
 mod support;
 
 use moreau::{
-    FullOrder, FullOrderGains, KalmanParams, ObserverParams, ReducedOrder, SaltationKalman,
-    Sensitivities, tune_process_noise,
+    FullOrder, FullOrderGains, KalmanParams, Observer, ObserverParams, ReducedOrder,
+    SaltationKalman, Sensitivities, tune_process_noise,
 };
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SVector, Vector2};

@@ -374,7 +374,7 @@ fn worst_rate<M: Model<2, 2, Scalar = f64>>(
 
 /// Feeds the samples' positions (from the second on) to `obs`: its
 /// estimates, the initial one first.
-fn run<O: Observer<f64, 2, 2>>(
+fn run<O: Observer<DoublePendulum<f64>, 2, 2>>(
     obs: &mut O,
     model: &DoublePendulum<f64>,
     samples: &[State<f64, 2>],

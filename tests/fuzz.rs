@@ -231,7 +231,7 @@ fn fuzz_observer<M, O, const N: usize, const K: usize, const NU: usize>(
 ) -> [usize; 3]
 where
     M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Clone,
-    O: Observer<f64, N, K> + Clone,
+    O: Observer<M, N, K> + Clone,
 {
     let mut twin = observer.clone();
     let u = SVector::<f64, NU>::zeros();

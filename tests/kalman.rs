@@ -21,25 +21,26 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
 // ---------------------------------------------------------------------------
 // Reference data (as in tests/observer.rs)
 
-/// Feeds the measurements (from the second on) to the filter and returns
-/// the estimates, the initial one first.
-fn filter_run<M, const N: usize, const K: usize>(
-    filter: &mut SaltationKalman<f64, N, K>,
+/// Feeds the measurements (from the second on) to any estimator (the
+/// filter and the observers alike, through the one `Observer` trait) and
+/// returns the estimates, the initial one first.
+fn run<O, M, const N: usize, const K: usize>(
+    estimator: &mut O,
     model: &M,
     reference: &Reference<N>,
     measured: &[SVector<f64, N>],
     u: &M::Input,
 ) -> Vec<Estimate<f64, N>>
 where
-    M: Sensitivities<N, K, Scalar = f64>,
+    O: Observer<M, N, K>,
+    M: Model<N, K, Scalar = f64>,
 {
-    let mut estimates = vec![filter.estimate()];
+    let mut estimates = vec![estimator.estimate()];
     for (s, q) in reference.samples.iter().zip(measured).skip(1) {
-        let before = *filter.covariance();
         estimates.push(
-            filter
+            estimator
                 .update(model, s.t, q, u)
-                .unwrap_or_else(|e| panic!("t = {}: {e:?} {before:?} {:?}", s.t, filter.report())),
+                .unwrap_or_else(|e| panic!("t = {}: {e:?} {:?}", s.t, estimator.report())),
         );
     }
     estimates
@@ -623,8 +624,13 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
     )
     .unwrap();
     eprintln!(
-        "tuned on one run: factor {:.3e}, q_a {:.3e}, log-likelihood {:.1}, {} runs",
-        tuned.factor, tuned.params.accel_noise[0], tuned.log_likelihood, tuned.evaluations
+        "tuned on one run: q_a {:.3e}, ρ_i {:.3e}, σ_t {:.3e}, ρ_c {:.3e}, log-likelihood {:.1}, {} runs",
+        tuned.params.accel_noise[0],
+        tuned.params.impact_noise,
+        tuned.params.impact_time_sigma,
+        tuned.params.contact_noise,
+        tuned.log_likelihood,
+        tuned.evaluations
     );
     tuned.params
 }
@@ -632,12 +638,19 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
 /// Example 1 on four initial states (the model file's, whose impacts
 /// accumulate at 4.456 s before it slides, and three more), `v̂(0) = 0`,
 /// 1 kHz samples of the plant at `τ = 1e-5`, scored over `[2, 10]` s; the
-/// process noise picked once by the likelihood helper from another noisy
-/// run. Asserted: with exact samples the median is at most 1e-8 (the
-/// issue's figure); with `σ = 1e-4` the filter's median and 90th
-/// percentile are below those of the reduced-order observer (38), told
-/// `σ`, on the same samples. (The issue's noisy targets, median ≤ 3e-5 and
-/// 90th percentile ≤ 2e-4, are not reached: the figures are printed.)
+/// four process-noise knobs picked once by the likelihood helper from
+/// another noisy run (the model file's start, its own noise seed).
+///
+/// Asserted: with exact samples the median is at most 1e-8 (the issue's
+/// figure); with `σ = 1e-4` the median is at most 1e-4 and the 90th
+/// percentile at most 4e-4 (the hand-written Python saltation filter the
+/// issue measured on such data: median 5e-5 to 1e-4, 90th percentile 2e-4
+/// to 7e-4), and the median at least ten times below that of the
+/// reduced-order observer (38), told `σ`, on the same samples. The
+/// issue's own targets (median ≤ 3e-5, 90th percentile ≤ 2e-4, maximum
+/// ≤ 1e-2 off the bracketing samples) are printed, not asserted: they are
+/// met on some starts only (the plant's own impacts deviate from the
+/// exact law by up to 4e-3 m/s at τ = 1e-5; see the note of issue 10).
 #[test]
 fn example_1_figures_beside_the_reduced_order_observer() {
     let model = Parabola::<f64>::new();
@@ -658,7 +671,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
             let mut f =
                 SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros())
                     .unwrap();
-            let est = filter_run(&mut f, &model, &data, &measured, &u);
+            let est = run(&mut f, &model, &data, &measured, &u);
             let sc = score(&data, &est);
             let mut o = ReducedOrder::<f64, 2, 2>::new(
                 ObserverParams::new(10.0, 20.0).with_noise(sigma),
@@ -667,10 +680,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 Vector2::zeros(),
             )
             .unwrap();
-            let mut obs = vec![o.estimate()];
-            for (s, q) in data.samples.iter().zip(&measured).skip(1) {
-                obs.push(o.update(&model, s.t, q, &u).unwrap());
-            }
+            let obs = run(&mut o, &model, &data, &measured, &u);
             let so = score(&data, &obs);
             eprintln!(
                 "Example 1, start {n}, σ = {sigma:e}: filter median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e}; samples to recover, worst {}), (38) median {:.2e} p90 {:.2e} max {:.2e}",
@@ -691,9 +701,12 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 assert!(sc.all.median <= 1e-8, "start {n}: {:e}", sc.all.median);
             } else {
                 assert!(
-                    sc.all.median < so.all.median && sc.all.p90 < so.all.p90,
-                    "start {n}"
+                    sc.all.median <= 1e-4 && sc.all.p90 <= 4e-4,
+                    "start {n}: median {:e}, p90 {:e}",
+                    sc.all.median,
+                    sc.all.p90
                 );
+                assert!(sc.all.median * 10.0 <= so.all.median, "start {n}");
             }
         }
     }
@@ -765,7 +778,7 @@ fn same_measurements_give_the_same_bits() {
             Vector2::zeros(),
         )
         .unwrap();
-        let e = filter_run(&mut f, &model, &data, &measured, &u);
+        let e = run(&mut f, &model, &data, &measured, &u);
         (bits(&e), *f.covariance())
     };
     let (a, pa) = run();

@@ -31,7 +31,7 @@ fn observe<O, M, const N: usize, const K: usize>(
     u: &M::Input,
 ) -> Vec<Estimate<f64, N>>
 where
-    O: Observer<f64, N, K>,
+    O: Observer<M, N, K>,
     M: Model<N, K, Scalar = f64>,
 {
     let mut estimates = vec![observer.estimate()];
@@ -1342,7 +1342,7 @@ fn samples_that_agree_with_each_other_restart_the_estimate() {
     let ro = ReducedOrder::<f64, 2, 2>::new(params, 0.0, wrong, Vector2::zeros()).unwrap();
     let gains = FullOrderGains::scalar(5.0, 25.0);
     let fo = FullOrder::<f64, 2, 2>::new(params, gains, 0.0, wrong, Vector2::zeros()).unwrap();
-    fn run<O: Observer<f64, 2, 2>>(
+    fn run<O: Observer<Parabola<f64>, 2, 2>>(
         mut o: O,
         name: &str,
         model: &Parabola<f64>,

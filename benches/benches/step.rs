@@ -77,7 +77,7 @@ fn observer_cases<M, O, T, const N: usize, const K: usize, const NU: usize>(
 where
     T: RealField + Copy,
     M: Model<N, K, Scalar = T, Input = SVector<T, NU>>,
-    O: Observer<T, N, K> + Copy,
+    O: Observer<M, N, K> + Copy,
 {
     let u = SVector::zeros();
     let mut cases: Vec<(&'static str, O, State<T, N>)> = Vec::new();

@@ -22,7 +22,7 @@ pub fn run<O, M, const N: usize, const K: usize, const NU: usize>(
     reference: &Reference<N>,
 ) -> Result<Estimates<N>>
 where
-    O: Observer<f64, N, K>,
+    O: Observer<M, N, K>,
     M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
 {
     let u = SVector::<f64, NU>::zeros();

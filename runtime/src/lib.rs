@@ -28,7 +28,7 @@ pub use interval::{Interval, LIBM_ULPS, next_down, next_up};
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Sensitivities, Structure, Terms};
 pub use observer::{
-    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    Blocks, KalmanParams, KalmanReport, NoiseFactors, Saltation, SaltationKalman, Tuning,
     constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
 };
 #[cfg(feature = "std")]

@@ -410,7 +410,7 @@ mod infeasible_state {
     use crate::{FullOrder, FullOrderGains, Observer, ObserverParams, ReducedOrder, Restart};
     use nalgebra::{SVector, Vector1};
 
-    fn check<O: Observer<f64, 1, 0>>(mut o: O) {
+    fn check<O: Observer<Cliff, 1, 0>>(mut o: O) {
         let u = SVector::zeros();
         // v̂ = −20 m/s predicts y = −2 m at 0.1 s, where F is NaN; the mass
         // in fact rests at y = 0 (held by something outside the model)

@@ -427,17 +427,18 @@ fn error_flow<T: RealField + Copy, const N: usize>(
     sum
 }
 
-impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for FullOrder<T, N, K> {
-    fn update<M>(
+impl<M, T, const N: usize, const K: usize> Observer<M, N, K> for FullOrder<T, N, K>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    fn update(
         &mut self,
         model: &M,
         t: T,
         q: &SVector<T, N>,
         u: &M::Input,
-    ) -> Result<Estimate<T, N>, ObserverError<T>>
-    where
-        M: Model<N, K, Scalar = T>,
-    {
+    ) -> Result<Estimate<T, N>, ObserverError<T>> {
         let memory = Memory {
             params: &self.params,
             lcp: &self.lcp,
@@ -480,23 +481,19 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K> for 
         let v = saturate(&v, self.params.velocity_bound);
         report.outliers = self.outliers.accept();
         (self.t, self.q, self.q_hat, self.v, self.report) = (t, *q, q_hat, v, report);
-        Ok(self.estimate())
+        Ok(Self::estimate(self))
     }
 
     fn estimate(&self) -> Estimate<T, N> {
-        Estimate {
-            t: self.t,
-            q: self.q_hat,
-            v: self.v,
-        }
+        Self::estimate(self)
     }
 
     fn report(&self) -> &UpdateReport<T, N, K> {
-        &self.report
+        Self::report(self)
     }
 
     fn params(&self) -> &ObserverParams<T> {
-        &self.params
+        Self::params(self)
     }
 }
 
@@ -531,5 +528,29 @@ mod tests {
                 "{ours} vs {exact}"
             );
         }
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
+    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
+    #[must_use]
+    pub fn estimate(&self) -> Estimate<T, N> {
+        Estimate {
+            t: self.t,
+            q: self.q_hat,
+            v: self.v,
+        }
+    }
+
+    /// What the last successful update did (also [`Observer::report`]).
+    #[must_use]
+    pub fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
+    /// The settings (also [`Observer::params`]).
+    #[must_use]
+    pub fn params(&self) -> &ObserverParams<T> {
+        &self.params
     }
 }

@@ -293,7 +293,7 @@ pub use full_order::{FullOrder, FullOrderGains};
 pub use gains::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};
 pub use gains::{Design, GainRegion, ModelBounds};
 pub use kalman::{
-    Blocks, KalmanParams, KalmanReport, Saltation, SaltationKalman, Tuning,
+    Blocks, KalmanParams, KalmanReport, NoiseFactors, Saltation, SaltationKalman, Tuning,
     constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
 };
 pub use params::{Discretization, ObserverParams};
@@ -310,8 +310,12 @@ use crate::validate;
 /// The paper's class of estimators (13)–(15): driven by measured positions
 /// `q(t_k)`, known inputs and time, never by the velocity.
 ///
-/// Implemented by [`ReducedOrder`] (38) and [`FullOrder`] (36). Every
-/// update is a pure function of the observer's state and its arguments:
+/// Implemented by [`ReducedOrder`] (38) and [`FullOrder`] (36) for every
+/// [`Model`], and by the [`SaltationKalman`] filter for every model with
+/// [`Sensitivities`](crate::Sensitivities) (all generated ones): the trait
+/// is generic over the model because the filter needs more of it than the
+/// observers. A function written against `O: Observer<M, N, K>` runs any
+/// of the three. Every update is a pure function of the observer's state and its arguments:
 /// the same measurements give the same bits (the well-posedness of
 /// Theorem 1, numerically). The derivations (the signs of (36) and (38),
 /// the discretization of one sampling interval with impacts inside it,
@@ -364,7 +368,10 @@ use crate::validate;
 /// }
 /// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
 /// ```
-pub trait Observer<T: RealField + Copy, const N: usize, const K: usize> {
+pub trait Observer<M, const N: usize, const K: usize>
+where
+    M: Model<N, K>,
+{
     /// Takes the measurement `q` at time `t > t_k` (the known input `u`
     /// applied over `[t_k, t]`) and returns the new estimate.
     ///
@@ -373,24 +380,23 @@ pub trait Observer<T: RealField + Copy, const N: usize, const K: usize> {
     /// An [`ObserverError`] naming the problem (a non-finite measurement,
     /// input or parameter, a time not after the last, a model that
     /// evaluates to NaN, ...); the observer's state is then unchanged.
-    fn update<M>(
+    fn update(
         &mut self,
         model: &M,
-        t: T,
-        q: &SVector<T, N>,
+        t: M::Scalar,
+        q: &SVector<M::Scalar, N>,
         u: &M::Input,
-    ) -> Result<Estimate<T, N>, ObserverError<T>>
-    where
-        M: Model<N, K, Scalar = T>;
+    ) -> Result<Estimate<M::Scalar, N>, ObserverError<M::Scalar>>;
 
     /// The current estimate.
-    fn estimate(&self) -> Estimate<T, N>;
+    fn estimate(&self) -> Estimate<M::Scalar, N>;
 
     /// What the last successful update did.
-    fn report(&self) -> &UpdateReport<T, N, K>;
+    fn report(&self) -> &UpdateReport<M::Scalar, N, K>;
 
-    /// The settings.
-    fn params(&self) -> &ObserverParams<T>;
+    /// The settings of the interval (the filter's
+    /// [`KalmanParams::observer`]).
+    fn params(&self) -> &ObserverParams<M::Scalar>;
 }
 
 /// Checks one update's data: returns `τ = t − last`.

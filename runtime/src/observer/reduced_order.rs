@@ -289,19 +289,18 @@ where
     Ok(v_free + dv)
 }
 
-impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
-    for ReducedOrder<T, N, K>
+impl<M, T, const N: usize, const K: usize> Observer<M, N, K> for ReducedOrder<T, N, K>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
 {
-    fn update<M>(
+    fn update(
         &mut self,
         model: &M,
         t: T,
         q: &SVector<T, N>,
         u: &M::Input,
-    ) -> Result<Estimate<T, N>, ObserverError<T>>
-    where
-        M: Model<N, K, Scalar = T>,
-    {
+    ) -> Result<Estimate<T, N>, ObserverError<T>> {
         let memory = Memory {
             params: &self.params,
             lcp: &self.lcp,
@@ -332,23 +331,19 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Observer<T, N, K>
         let v = saturate(&v, self.params.velocity_bound);
         report.outliers = self.outliers.accept();
         (self.t, self.q, self.v, self.report) = (t, *q, v, report);
-        Ok(self.estimate())
+        Ok(Self::estimate(self))
     }
 
     fn estimate(&self) -> Estimate<T, N> {
-        Estimate {
-            t: self.t,
-            q: self.q,
-            v: self.v,
-        }
+        Self::estimate(self)
     }
 
     fn report(&self) -> &UpdateReport<T, N, K> {
-        &self.report
+        Self::report(self)
     }
 
     fn params(&self) -> &ObserverParams<T> {
-        &self.params
+        Self::params(self)
     }
 }
 
@@ -514,5 +509,29 @@ mod tests {
         // single precision: positions to 6e-8 m over τ = 1 ms are velocities
         // to ~1e-4 m/s, times the gain's filtering
         assert!(worst < 1e-2, "{worst}");
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
+    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
+    #[must_use]
+    pub fn estimate(&self) -> Estimate<T, N> {
+        Estimate {
+            t: self.t,
+            q: self.q,
+            v: self.v,
+        }
+    }
+
+    /// What the last successful update did (also [`Observer::report`]).
+    #[must_use]
+    pub fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
+    /// The settings (also [`Observer::params`]).
+    #[must_use]
+    pub fn params(&self) -> &ObserverParams<T> {
+        &self.params
     }
 }

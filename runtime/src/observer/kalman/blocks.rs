@@ -1,7 +1,7 @@
 //! `2N × 2N` matrices over the state `(q, v)`, kept as their four `N × N`
 //! blocks (stable Rust has no `SMatrix<T, {2 * N}, {2 * N}>`).
 
-use nalgebra::{RealField, SMatrix};
+use nalgebra::{RealField, SMatrix, SVector};
 
 /// A `2N × 2N` matrix over the state `x = (q, v)`, as its four `N × N`
 /// blocks:
@@ -107,6 +107,44 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
             qv: self.qv + o.qv,
             vq: self.vq + o.vq,
             vv: self.vv + o.vv,
+        }
+    }
+
+    /// The product `c · self`.
+    ///
+    /// ```
+    /// use moreau_runtime::Blocks;
+    ///
+    /// let b = Blocks::<f64, 2>::identity().scaled(3.0);
+    /// assert_eq!((b.entry(0, 0), b.entry(3, 3), b.entry(0, 2)), (3.0, 3.0, 0.0));
+    /// ```
+    #[must_use]
+    pub fn scaled(&self, c: T) -> Self {
+        Self {
+            qq: self.qq * c,
+            qv: self.qv * c,
+            vq: self.vq * c,
+            vv: self.vv * c,
+        }
+    }
+
+    /// The outer product `x xᵀ` of the stacked vector `x = (a, b)`.
+    ///
+    /// ```
+    /// use moreau_runtime::Blocks;
+    /// use nalgebra::Vector1;
+    ///
+    /// let b = Blocks::outer(&Vector1::new(2.0), &Vector1::new(3.0));
+    /// assert_eq!((b.entry(0, 0), b.entry(0, 1), b.entry(1, 0), b.entry(1, 1)), (4.0, 6.0, 6.0, 9.0));
+    /// ```
+    #[must_use]
+    pub fn outer(a: &SVector<T, N>, b: &SVector<T, N>) -> Self {
+        let ab = a * b.transpose();
+        Self {
+            qq: a * a.transpose(),
+            qv: ab,
+            vq: ab.transpose(),
+            vv: b * b.transpose(),
         }
     }
 

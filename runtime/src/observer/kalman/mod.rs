@@ -58,23 +58,24 @@
 //! model's generated [`Model::linearization`](crate::Model::linearization) and [`Sensitivities`].
 
 mod blocks;
+mod propagate;
 mod saltation;
 mod tune;
 
 pub use blocks::Blocks;
 pub use saltation::{Saltation, constrained_flow_jacobian, flow_jacobian, saltation, transition};
-pub use tune::{Tuning, tune_process_noise};
+pub use tune::{NoiseFactors, Tuning, tune_process_noise};
 
 use nalgebra::{RealField, SMatrix, SVector};
 
-use crate::lcp::{IndexSet, Lcp};
+use crate::lcp::Lcp;
 use crate::model::Sensitivities;
 
-use super::interval::{Cache, Flight, Interval, Jump, Memory, Tracer, saturate};
-use super::{Estimate, ObserverError, ObserverParams, UpdateReport};
+use super::interval::{Cache, Interval, Memory};
+use super::{Estimate, Observer, ObserverError, ObserverParams, UpdateReport};
 use crate::error::DataError;
-use crate::validate::{self, factor_mass};
-use saltation::project_onto_contact;
+use crate::validate;
+use propagate::Propagation;
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
@@ -114,6 +115,29 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// coordinate (default `C_v`, the velocity bound: what the filter knows
     /// of a velocity it has not seen).
     pub initial_velocity_sigma: T,
+    /// Relative accuracy `ρ_i` of an impact's velocity jump
+    /// (dimensionless): the post-impact velocity error has the covariance
+    /// `ρ_i² (ΔvᵀMΔv/N) M⁻¹`, isotropic in the kinetic-energy metric with
+    /// `ρ_i²` times the jump's energy (module `propagate`). Default `1e-3`:
+    /// a restitution coefficient and a contact normal known to about 0.1 %.
+    pub impact_noise: T,
+    /// Standard deviation `σ_t` of an impact's instant, in seconds: the
+    /// filter takes every impact to be instantaneous and at the located
+    /// time, and this is what it allows for a real one (a contact that
+    /// lasts, a plant that meets the constraint on its own time grid). At
+    /// each impact it adds `σ_t² d dᵀ` to the covariance, with `d` the
+    /// state's shift per unit of impact delay
+    /// ([`Saltation::timing`](super::Saltation)): the velocity jump in
+    /// position, the change of acceleration in velocity. Default `1e-4`
+    /// (a tenth of a millisecond, the duration of a hard contact).
+    pub impact_time_sigma: T,
+    /// Relative accuracy `ρ_c` of a persistent contact's force, as a
+    /// density (units √s): along a piece of sliding or resting contact
+    /// with contact acceleration `a_c = M⁻¹Jᵀλ`, white acceleration noise
+    /// of density `ρ_c² (a_cᵀ M a_c / N) M⁻¹` (friction, compliance and a
+    /// discretised plant's drift along a curved surface are what the
+    /// frictionless rigid contact leaves out). Default `1e-3`.
+    pub contact_noise: T,
 }
 
 /// `χ²_N` quantile `z` standard deviations out, by Wilson–Hilferty:
@@ -145,6 +169,9 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             gate: chi_square_quantile(N, nalgebra::convert(4.0)),
             max_outliers: 2,
             initial_velocity_sigma: velocity_bound,
+            impact_noise: nalgebra::convert(1e-3),
+            impact_time_sigma: nalgebra::convert(1e-4),
+            contact_noise: nalgebra::convert(1e-3),
         }
     }
 
@@ -171,6 +198,27 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     pub fn scaled(self, factor: T) -> Self {
         Self {
             accel_noise: self.accel_noise * factor,
+            ..self
+        }
+    }
+
+    /// The same settings with each process-noise knob scaled by its
+    /// factor (what [`tune_process_noise`] returns).
+    ///
+    /// ```
+    /// use moreau_runtime::{KalmanParams, NoiseFactors};
+    ///
+    /// let f = NoiseFactors { accel: 2.0, impact: 1.0, impact_time: 0.5, contact: 1.0 };
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).scaled_by(&f);
+    /// assert_eq!((p.accel_noise[0], p.impact_time_sigma), (2e-2, 5e-5));
+    /// ```
+    #[must_use]
+    pub fn scaled_by(self, f: &NoiseFactors<T>) -> Self {
+        Self {
+            accel_noise: self.accel_noise * f.accel,
+            impact_noise: self.impact_noise * f.impact,
+            impact_time_sigma: self.impact_time_sigma * f.impact_time,
+            contact_noise: self.contact_noise * f.contact,
             ..self
         }
     }
@@ -207,6 +255,15 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
         let s = self.initial_velocity_sigma;
         if !(s > T::zero() && s.is_finite()) {
             return bad("initial_velocity_sigma", s);
+        }
+        for (name, s) in [
+            ("impact_noise", self.impact_noise),
+            ("impact_time_sigma", self.impact_time_sigma),
+            ("contact_noise", self.contact_noise),
+        ] {
+            if !(s >= T::zero() && s.is_finite()) {
+                return bad(name, s);
+            }
         }
         Ok(())
     }
@@ -425,7 +482,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         })
     }
 
-    /// The current estimate `(q̂, v̂)`.
+    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
+    #[must_use]
     pub fn estimate(&self) -> Estimate<T, N> {
         Estimate {
             t: self.t,
@@ -434,15 +492,16 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         }
     }
 
+    /// What the last successful update's interval did (impacts, contacts,
+    /// the innovation; also [`Observer::report`]).
+    #[must_use]
+    pub fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
     /// The covariance `P` of the estimate.
     pub fn covariance(&self) -> &Blocks<T, N> {
         &self.p
-    }
-
-    /// What the last successful update's interval did (impacts, contacts,
-    /// the innovation).
-    pub fn report(&self) -> &UpdateReport<T, N, K> {
-        &self.report
     }
 
     /// What the last successful update's covariance did (the normalised
@@ -455,28 +514,44 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     pub fn params(&self) -> &KalmanParams<T, N> {
         &self.params
     }
+}
 
-    /// Takes the measurement `q` at time `t > t_k` (the known input `u`
-    /// applied over `[t_k, t]`) and returns the new estimate.
-    ///
-    /// # Errors
-    ///
-    /// An [`ObserverError`] naming the problem (a non-finite measurement,
-    /// input or parameter, a time not after the last, a model that
-    /// evaluates to NaN, an innovation covariance that is not positive
-    /// definite: `InvalidParams { name: "measurement" }`); the filter's
-    /// state is then unchanged, bit for bit. An outlier is no error: it is
-    /// reported in [`KalmanReport::outlier`].
-    pub fn update<M>(
+/// The filter is an [`Observer`] of every model with [`Sensitivities`]:
+/// [`update`](Observer::update) is one predict–gate–update cycle (module
+/// docs); [`params`](Observer::params) gives the interval's settings
+/// ([`KalmanParams::observer`]), the inherent
+/// [`SaltationKalman::params`] all of them.
+///
+/// An update's errors name the problem (a non-finite measurement, input
+/// or parameter, a time not after the last, a model that evaluates to NaN,
+/// an innovation covariance that is not positive definite:
+/// `InvalidParams { name: "measurement" }`); the filter's state is then
+/// unchanged, bit for bit. An outlier is no error: it is reported in
+/// [`KalmanReport::outlier`].
+impl<M, T, const N: usize, const K: usize> Observer<M, N, K> for SaltationKalman<T, N, K>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    fn estimate(&self) -> Estimate<T, N> {
+        Self::estimate(self)
+    }
+
+    fn report(&self) -> &UpdateReport<T, N, K> {
+        Self::report(self)
+    }
+
+    fn params(&self) -> &ObserverParams<T> {
+        &self.params.observer
+    }
+
+    fn update(
         &mut self,
         model: &M,
         t: T,
         q: &SVector<T, N>,
         u: &M::Input,
-    ) -> Result<Estimate<T, N>, T>
-    where
-        M: Sensitivities<N, K, Scalar = T>,
-    {
+    ) -> Result<Estimate<T, N>, T> {
         // the contact rule's band and velocity noise are those of the
         // estimate the prediction starts from, not of a raw sample
         let sigma_q = self.p.qq.diagonal().amax().max(T::zero()).sqrt();
@@ -503,20 +578,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         interval.uncertainty = rule.noise_sigmas * sigma_v;
         report.gain = interval.gain;
         // PREDICT, the covariance following every piece and impact
-        let mut propagation = Propagation {
-            model,
-            u,
-            t0: self.t,
-            bound: self.params.observer.velocity_bound,
-            density: self
-                .params
-                .accel_noise
-                .component_mul(&self.params.accel_noise),
-            p: self.p,
-            correction: (SVector::zeros(), SVector::zeros()),
-            saltations: 0,
-            projections: 0,
-        };
+        let mut propagation = Propagation::new(model, u, self.t, &self.params, self.p);
         let (q_pred, v_pred) = interval.predict_traced(&self.v, &mut report, &mut propagation)?;
         let (q_pred, v_pred) = (
             q_pred + propagation.correction.0,
@@ -551,13 +613,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         let gate = self.params.gate;
         if nis > gate && self.outliers >= self.params.max_outliers {
             // the model, not the sample, is wrong: widen the prediction
-            let factor = nis / nalgebra::convert(N.max(1) as f64);
-            p = Blocks {
-                qq: p.qq * factor,
-                qv: p.qv * factor,
-                vq: p.vq * factor,
-                vv: p.vv * factor,
-            };
+            p = p.scaled(nis / nalgebra::convert(N.max(1) as f64));
             kalman.inflated = true;
             s = p.qq + r;
             chol = nalgebra::linalg::Cholesky::new(s).ok_or_else(not_pd)?;
@@ -603,145 +659,6 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         }
         (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
-        Ok(self.estimate())
-    }
-}
-
-/// The covariance along the predicted motion of one interval.
-struct Propagation<'a, M, T, const N: usize, const K: usize>
-where
-    T: RealField + Copy,
-    M: Sensitivities<N, K, Scalar = T>,
-{
-    model: &'a M,
-    u: &'a M::Input,
-    t0: T,
-    bound: T,
-    /// `q_a²` per coordinate.
-    density: SVector<T, N>,
-    p: Blocks<T, N>,
-    /// The move of the predicted end onto the contact manifold, when the
-    /// last piece was a persistent contact.
-    correction: (SVector<T, N>, SVector<T, N>),
-    saltations: u32,
-    projections: u32,
-}
-
-/// `Q(h) = [[h³/3, h²/2], [h²/2, h]] ⊗ diag(q_a²)`: white acceleration
-/// noise integrated exactly over `h` for `q'' = w`.
-fn process_noise<T: RealField + Copy, const N: usize>(
-    density: &SVector<T, N>,
-    h: T,
-) -> Blocks<T, N> {
-    let d = SMatrix::<T, N, N>::from_diagonal(density);
-    let h2 = h * h;
-    let qv = d * (h2 * nalgebra::convert(0.5));
-    Blocks {
-        qq: d * (h2 * h / nalgebra::convert(3.0)),
-        qv,
-        vq: qv,
-        vv: d * h,
-    }
-}
-
-impl<M, T, const N: usize, const K: usize> Tracer<T, N, K> for Propagation<'_, M, T, N, K>
-where
-    T: RealField + Copy,
-    M: Sensitivities<N, K, Scalar = T>,
-{
-    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
-        let w0 = saturate(piece.w0, self.bound);
-        let t = self.t0 + piece.s0;
-        // the contacts that pushed along the piece
-        let mut held = IndexSet::EMPTY;
-        for i in piece.sliding.iter().filter(|&i| i < K) {
-            if piece.impulse[i] > T::zero() {
-                held.insert(i);
-            }
-        }
-        let (a, _) = if held.is_empty() {
-            flow_jacobian(self.model, t, piece.p0, &w0, self.u)?
-        } else {
-            constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
-        };
-        let noise = process_noise(&self.density, piece.h);
-        let mut p = transition(&a, piece.h).congruence(&self.p);
-        self.correction = (SVector::zeros(), SVector::zeros());
-        if held.is_empty() {
-            p = p.add(&noise);
-        } else {
-            p = p.add(&noise);
-            // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
-            // the covariance, and the state in the same metric
-            let (h, jac) = self.model.contact(piece.p1);
-            let rate = self.model.jacobian_dq(piece.p1, piece.w1);
-            validate::finite_model(&h, "h")?;
-            validate::finite_model(&jac, "J")?;
-            validate::finite_model(&rate, "d(Jv)/dq")?;
-            let mass = factor_mass(&self.model.mass(piece.p1))?;
-            if let Some((projected, dq, dv)) =
-                project_onto_contact(&p, &mass, &h, &jac, &rate, piece.w1, held)
-            {
-                p = projected;
-                self.correction = (dq, dv);
-                self.projections += 1;
-            }
-            // what the contact leaves uncertain across it: the noise's
-            // position and velocity variances, uncorrelated (a correlated
-            // floor would turn the contact's own penetration, seen in the
-            // samples, into a velocity)
-            p = p.add(&Blocks::diagonal(noise.qq, noise.vv));
-        }
-        self.p = p.symmetrized();
-        Ok(())
-    }
-
-    fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T> {
-        let mut active = IndexSet::EMPTY;
-        let mut e = SVector::<T, K>::zeros();
-        for i in jump.set.iter().filter(|&i| i < K) {
-            if jump.lambda[i] > T::zero() {
-                active.insert(i);
-                if jump.elastic.contains(i) {
-                    e[i] = jump.restitution[i];
-                }
-            }
-        }
-        if active.is_empty() {
-            return Ok(());
-        }
-        // the impact time moves with the constraint whose root timed it
-        // (the fastest-approaching if several), for an elastic law only
-        let (_, jac) = self.model.contact(jump.p);
-        let guard = jump
-            .guard
-            .intersection(jump.elastic)
-            .intersection(active)
-            .iter()
-            .filter(|&i| i < K)
-            .map(|i| {
-                let row = jac.row(i);
-                (i, row.dot(&jump.w_minus.transpose()) / row.norm())
-            })
-            .fold(None, |best: Option<(usize, T)>, (i, r)| match best {
-                Some((_, b)) if b <= r => best,
-                _ => Some((i, r)),
-            })
-            .map(|(i, _)| i);
-        self.correction = (SVector::zeros(), SVector::zeros());
-        let w = saturate(jump.w_minus, self.bound);
-        let s = saltation(
-            self.model,
-            self.t0 + jump.s,
-            jump.p,
-            &w,
-            self.u,
-            active,
-            &e,
-            guard,
-        )?;
-        self.p = s.matrix.congruence(&self.p);
-        self.saltations += 1;
-        Ok(())
+        Ok(Self::estimate(self))
     }
 }

@@ -6,16 +6,41 @@ use nalgebra::{RealField, SVector};
 use crate::error::DataError;
 use crate::model::Sensitivities;
 
-use super::super::ObserverError;
+use super::super::{Observer, ObserverError};
 use super::{KalmanParams, KalmanReport, SaltationKalman};
+
+/// Factors applied to the process-noise knobs of [`KalmanParams`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseFactors<T> {
+    /// On [`KalmanParams::accel_noise`].
+    pub accel: T,
+    /// On [`KalmanParams::impact_noise`].
+    pub impact: T,
+    /// On [`KalmanParams::impact_time_sigma`].
+    pub impact_time: T,
+    /// On [`KalmanParams::contact_noise`].
+    pub contact: T,
+}
+
+impl<T: RealField + Copy> NoiseFactors<T> {
+    /// `ten^x` for each exponent, in the order of the fields.
+    fn from_exponents(x: &[T; KNOBS], ten: T) -> Self {
+        Self {
+            accel: ten.powf(x[0]),
+            impact: ten.powf(x[1]),
+            impact_time: ten.powf(x[2]),
+            contact: ten.powf(x[3]),
+        }
+    }
+}
 
 /// The outcome of [`tune_process_noise`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tuning<T: RealField + Copy, const N: usize> {
     /// The settings with the chosen process noise.
     pub params: KalmanParams<T, N>,
-    /// The factor applied to the given `accel_noise`.
-    pub factor: T,
+    /// The factors applied to the given knobs.
+    pub factors: NoiseFactors<T>,
     /// The innovation log-likelihood of the run at that factor,
     /// `Σ_k −½ (y_kᵀS_k⁻¹y_k + ln det S_k + N ln 2π)`.
     pub log_likelihood: T,
@@ -78,7 +103,9 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
 /// }
 /// let params = KalmanParams::<f64, 1>::new(10.0, 3e-6);
 /// let tuned = tune_process_noise::<_, _, 1, 0>(&Free, params, &t, &q, &Vector1::zeros(), &SVector::zeros(), (-2.0, 4.0))?;
-/// assert!(tuned.factor > 2.0, "{}", tuned.factor);
+/// assert!(tuned.factors.accel > 2.0, "{:?}", tuned.factors);
+/// // no contact in the record: the contact knobs keep their values
+/// assert_eq!((tuned.factors.impact, tuned.factors.contact), (1.0, 1.0));
 /// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
 /// ```
 ///
@@ -109,9 +136,9 @@ where
     }
     let ten: T = nalgebra::convert(10.0);
     let mut evaluations = 0u32;
-    let mut likelihood = |x: T| -> Result<T, ObserverError<T>> {
+    let mut likelihood = |x: &[T; KNOBS]| -> Result<T, ObserverError<T>> {
         evaluations += 1;
-        let p = params.scaled(ten.powf(x));
+        let p = params.scaled_by(&NoiseFactors::from_exponents(x, ten));
         let mut filter = SaltationKalman::<T, N, K>::new(p, t[0], q[0], *v0)?;
         let mut total = T::zero();
         for (&tk, qk) in t.iter().zip(q).skip(1) {
@@ -128,43 +155,71 @@ where
         }
         Ok(total)
     };
-    // a grid in log s, then golden-section search around its best point
-    const GRID: usize = 9;
+    // coordinate ascent in the exponents, from the defaults (0): the
+    // first sweep a grid over [lo, hi] and golden-section search around
+    // its best point, the second golden-section search around the first
+    // sweep's point
     let step = (hi - lo) / nalgebra::convert((GRID - 1) as f64);
-    let (mut best_x, mut best) = (
-        lo,
-        T::min_value().unwrap_or(-T::one() / T::default_epsilon()),
-    );
-    let mut first = true;
-    for j in 0..GRID {
-        let x = lo + step * nalgebra::convert(j as f64);
-        let l = likelihood(x)?;
-        if first || l > best {
-            (best_x, best, first) = (x, l, false);
+    let mut x = [T::zero(); KNOBS];
+    let mut best = likelihood(&x)?;
+    for sweep in 0..2 {
+        for knob in 0..KNOBS {
+            let mut centre = x[knob];
+            if sweep == 0 {
+                for j in 0..GRID {
+                    let mut y = x;
+                    y[knob] = lo + step * nalgebra::convert(j as f64);
+                    let l = likelihood(&y)?;
+                    if l > best {
+                        (best, centre) = (l, y[knob]);
+                    }
+                }
+            }
+            let bracket = ((centre - step).max(lo), (centre + step).min(hi));
+            let (xk, l) = golden(bracket, |v| {
+                let mut y = x;
+                y[knob] = v;
+                likelihood(&y)
+            })?;
+            x[knob] = if l > best { xk } else { centre };
+            best = best.max(l);
         }
     }
+    let factors = NoiseFactors::from_exponents(&x, ten);
+    Ok(Tuning {
+        params: params.scaled_by(&factors),
+        factors,
+        log_likelihood: best,
+        evaluations,
+    })
+}
+
+/// Points of the first sweep's grid per knob.
+const GRID: usize = 7;
+/// The knobs: acceleration, impact, impact-time and contact noise.
+const KNOBS: usize = 4;
+
+/// The maximum of `f` over `[a, b]` by golden-section search (14 steps),
+/// with its value.
+fn golden<T, F>((mut a, mut b): (T, T), mut f: F) -> Result<(T, T), ObserverError<T>>
+where
+    T: RealField + Copy,
+    F: FnMut(T) -> Result<T, ObserverError<T>>,
+{
     let ratio: T = nalgebra::convert(0.618_033_988_749_895);
-    let (mut a, mut b) = ((best_x - step).max(lo), (best_x + step).min(hi));
     let mut c = b - (b - a) * ratio;
     let mut d = a + (b - a) * ratio;
-    let (mut fc, mut fd) = (likelihood(c)?, likelihood(d)?);
-    for _ in 0..24 {
+    let (mut fc, mut fd) = (f(c)?, f(d)?);
+    for _ in 0..14 {
         if fc > fd {
             (b, d, fd) = (d, c, fc);
             c = b - (b - a) * ratio;
-            fc = likelihood(c)?;
+            fc = f(c)?;
         } else {
             (a, c, fc) = (c, d, fd);
             d = a + (b - a) * ratio;
-            fd = likelihood(d)?;
+            fd = f(d)?;
         }
     }
-    let (x, l) = if fc > fd { (c, fc) } else { (d, fd) };
-    let (x, l) = if l > best { (x, l) } else { (best_x, best) };
-    Ok(Tuning {
-        params: params.scaled(ten.powf(x)),
-        factor: ten.powf(x),
-        log_likelihood: l,
-        evaluations,
-    })
+    Ok(if fc > fd { (c, fc) } else { (d, fd) })
 }

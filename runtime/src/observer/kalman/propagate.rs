@@ -1,0 +1,279 @@
+//! The covariance along the predicted motion of one interval: the
+//! [`Tracer`] that the filter hands to the observers' interval, and the
+//! process noise it adds on each piece and at each impact.
+//!
+//! # Process noise
+//!
+//! What the model leaves out enters in three places, each a knob of
+//! [`KalmanParams`] with a physical meaning:
+//!
+//! - **everywhere**, white acceleration noise of density `diag(q_a²)`
+//!   ([`KalmanParams::accel_noise`]), integrated exactly for `q'' = w`
+//!   over a piece of length `h`: `[[h³/3, h²/2], [h²/2, h]] ⊗ diag(q_a²)`;
+//! - **at an impact**, the velocity jump `Δv = v⁺ − v⁻` is known only to a
+//!   relative accuracy `ρ_i` ([`KalmanParams::impact_noise`]; restitution
+//!   coefficients and contact normals are never exact), and the impact's
+//!   instant only to `σ_t` ([`KalmanParams::impact_time_sigma`]; a real
+//!   impact lasts): `P_vv += ρ_i² (ΔvᵀMΔv / N) M⁻¹` (isotropic in the
+//!   metric of the kinetic energy: the error's expected energy is `ρ_i²`
+//!   times the jump's) and `P += σ_t² d dᵀ`, `d` the post-impact state's
+//!   shift per unit of delay ([`Saltation::timing`]);
+//! - **along a persistent contact**, the contact force `M⁻¹Jᵀλ = a_c` is
+//!   known only to a relative density `ρ_c` ([`KalmanParams::contact_noise`];
+//!   friction, compliance, a discretised plant's drift along a curved
+//!   surface): white acceleration noise of density
+//!   `ρ_c² (a_cᵀ M a_c / N) M⁻¹`, projected with the rest onto the contact
+//!   manifold.
+//!
+//! The two contact terms scale with what the contacts do, so a filter
+//! tuned on one run carries over to runs with harder or softer impacts;
+//! [`tune_process_noise`](super::tune_process_noise) picks all four knobs
+//! from a recorded run.
+
+use nalgebra::{RealField, SMatrix, SVector};
+
+use crate::lcp::IndexSet;
+use crate::linalg::Cholesky;
+use crate::model::Sensitivities;
+use crate::validate::{self, factor_mass};
+
+use super::super::ObserverError;
+use super::super::interval::{Flight, Jump, Tracer, saturate};
+use super::saltation::{
+    Saltation, constrained_flow_jacobian, flow_jacobian, project_onto_contact, saltation,
+    transition,
+};
+use super::{Blocks, KalmanParams};
+
+type Result<X, T> = core::result::Result<X, ObserverError<T>>;
+
+/// The covariance along the predicted motion of one interval.
+pub(super) struct Propagation<'a, M, T, const N: usize, const K: usize>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    model: &'a M,
+    u: &'a M::Input,
+    t0: T,
+    bound: T,
+    /// `q_a²` per coordinate.
+    density: SVector<T, N>,
+    /// `ρ_i²`, `ρ_c²` and `σ_t²`.
+    impact: T,
+    contact: T,
+    timing: T,
+    /// The covariance so far.
+    pub p: Blocks<T, N>,
+    /// The move of the predicted end onto the contact manifold, when the
+    /// last piece was a persistent contact.
+    pub correction: (SVector<T, N>, SVector<T, N>),
+    pub saltations: u32,
+    pub projections: u32,
+}
+
+impl<'a, M, T, const N: usize, const K: usize> Propagation<'a, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    /// Follows `p` from `t0` under the noise of `params`.
+    pub fn new(
+        model: &'a M,
+        u: &'a M::Input,
+        t0: T,
+        params: &KalmanParams<T, N>,
+        p: Blocks<T, N>,
+    ) -> Self {
+        let square = |x: T| x * x;
+        Self {
+            model,
+            u,
+            t0,
+            bound: params.observer.velocity_bound,
+            density: params.accel_noise.component_mul(&params.accel_noise),
+            impact: square(params.impact_noise),
+            contact: square(params.contact_noise),
+            timing: square(params.impact_time_sigma),
+            p,
+            correction: (SVector::zeros(), SVector::zeros()),
+            saltations: 0,
+            projections: 0,
+        }
+    }
+}
+
+/// White acceleration noise of density `d` (a symmetric `N × N` matrix)
+/// integrated exactly over `h` for `q'' = w`:
+/// `[[h³/3, h²/2], [h²/2, h]] ⊗ d`.
+fn white_noise<T: RealField + Copy, const N: usize>(d: &SMatrix<T, N, N>, h: T) -> Blocks<T, N> {
+    let h2 = h * h;
+    let qv = d * (h2 * nalgebra::convert(0.5));
+    Blocks {
+        qq: d * (h2 * h / nalgebra::convert(3.0)),
+        qv,
+        vq: qv,
+        vv: d * h,
+    }
+}
+
+/// `(wᵀ M w / N) M⁻¹`: the covariance of an error isotropic in the metric
+/// of the kinetic energy whose expected energy is that of `w`.
+fn energy_isotropic<T: RealField + Copy, const N: usize>(
+    mass: &SMatrix<T, N, N>,
+    chol: &Cholesky<T, N>,
+    w: &SVector<T, N>,
+) -> SMatrix<T, N, N> {
+    let scale = w.dot(&(mass * w)) / nalgebra::convert(N.max(1) as f64);
+    chol.solve(&SMatrix::identity()) * scale
+}
+
+impl<M, T, const N: usize, const K: usize> Propagation<'_, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    /// The relative noise of the contact force that pushed along `piece`
+    /// on the constraints `held`: `ρ_c² (a_cᵀ M a_c / N) M⁻¹` with
+    /// `a_c = M⁻¹ J_heldᵀ ∫λ / h`.
+    fn contact_density(
+        &self,
+        piece: &Flight<'_, T, N, K>,
+        held: IndexSet<K>,
+        jac: &SMatrix<T, K, N>,
+        (mass, chol): (&SMatrix<T, N, N>, &Cholesky<T, N>),
+    ) -> SMatrix<T, N, N> {
+        if self.contact == T::zero() || piece.h <= T::zero() {
+            return SMatrix::zeros();
+        }
+        let mut push = SVector::<T, N>::zeros();
+        for i in held.iter().filter(|&i| i < K) {
+            push += jac.row(i).transpose() * piece.impulse[i];
+        }
+        let accel = chol.solve(&push) / piece.h;
+        energy_isotropic(mass, chol, &accel) * self.contact
+    }
+
+    /// The noise an impact adds: `ρ_i² (ΔvᵀMΔv/N) M⁻¹` on the velocity and
+    /// `σ_t² d dᵀ` along the delay direction.
+    fn impact_noise(
+        &self,
+        s: &Saltation<T, N, K>,
+        q: &SVector<T, N>,
+        w: &SVector<T, N>,
+    ) -> Result<Blocks<T, N>, T> {
+        let (dq, dv) = s.timing;
+        let mut noise = Blocks::outer(&dq, &dv).scaled(self.timing);
+        if self.impact > T::zero() {
+            let mass = self.model.mass(q);
+            validate::finite_model(&mass, "M")?;
+            let chol = factor_mass(&mass)?;
+            noise.vv += energy_isotropic(&mass, &chol, &(s.v_plus - w)) * self.impact;
+        }
+        Ok(noise)
+    }
+}
+
+impl<M, T, const N: usize, const K: usize> Tracer<T, N, K> for Propagation<'_, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
+        let w0 = saturate(piece.w0, self.bound);
+        let t = self.t0 + piece.s0;
+        // the contacts that pushed along the piece
+        let mut held = IndexSet::EMPTY;
+        for i in piece.sliding.iter().filter(|&i| i < K) {
+            if piece.impulse[i] > T::zero() {
+                held.insert(i);
+            }
+        }
+        let (a, _) = if held.is_empty() {
+            flow_jacobian(self.model, t, piece.p0, &w0, self.u)?
+        } else {
+            constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
+        };
+        let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
+        let mut p = transition(&a, piece.h).congruence(&self.p).add(&noise);
+        self.correction = (SVector::zeros(), SVector::zeros());
+        if !held.is_empty() {
+            // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
+            // the covariance, and the state in the same metric
+            let (h, jac) = self.model.contact(piece.p1);
+            let rate = self.model.jacobian_dq(piece.p1, piece.w1);
+            validate::finite_model(&h, "h")?;
+            validate::finite_model(&jac, "J")?;
+            validate::finite_model(&rate, "d(Jv)/dq")?;
+            let m = self.model.mass(piece.p1);
+            validate::finite_model(&m, "M")?;
+            let mass = factor_mass(&m)?;
+            let contact = self.contact_density(piece, held, &jac, (&m, &mass));
+            p = p.add(&white_noise(&contact, piece.h));
+            if let Some((projected, dq, dv)) =
+                project_onto_contact(&p, &mass, &h, &jac, &rate, piece.w1, held)
+            {
+                p = projected;
+                self.correction = (dq, dv);
+                self.projections += 1;
+            }
+            // what the contact leaves uncertain across it: the noise's
+            // position and velocity variances, uncorrelated (a correlated
+            // floor would turn the contact's own penetration, seen in the
+            // samples, into a velocity)
+            p = p.add(&Blocks::diagonal(noise.qq, noise.vv));
+        }
+        self.p = p.symmetrized();
+        Ok(())
+    }
+
+    fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T> {
+        let mut active = IndexSet::EMPTY;
+        let mut e = SVector::<T, K>::zeros();
+        for i in jump.set.iter().filter(|&i| i < K) {
+            if jump.lambda[i] > T::zero() {
+                active.insert(i);
+                if jump.elastic.contains(i) {
+                    e[i] = jump.restitution[i];
+                }
+            }
+        }
+        if active.is_empty() {
+            return Ok(());
+        }
+        // the impact time moves with the constraint whose root timed it
+        // (the fastest-approaching if several), for an elastic law only
+        let (_, jac) = self.model.contact(jump.p);
+        let guard = jump
+            .guard
+            .intersection(jump.elastic)
+            .intersection(active)
+            .iter()
+            .filter(|&i| i < K)
+            .map(|i| {
+                let row = jac.row(i);
+                (i, row.dot(&jump.w_minus.transpose()) / row.norm())
+            })
+            .fold(None, |best: Option<(usize, T)>, (i, r)| match best {
+                Some((_, b)) if b <= r => best,
+                _ => Some((i, r)),
+            })
+            .map(|(i, _)| i);
+        self.correction = (SVector::zeros(), SVector::zeros());
+        let w = saturate(jump.w_minus, self.bound);
+        let s = saltation(
+            self.model,
+            self.t0 + jump.s,
+            jump.p,
+            &w,
+            self.u,
+            active,
+            &e,
+            guard,
+        )?;
+        let noise = self.impact_noise(&s, jump.p, &w)?;
+        self.p = s.matrix.congruence(&self.p).add(&noise).symmetrized();
+        self.saltations += 1;
+        Ok(())
+    }
+}
