@@ -20,11 +20,11 @@
 mod support;
 
 use moreau::{
-    FullOrder, FullOrderGains, KalmanParams, Observer, ObserverParams, ReducedOrder,
-    SaltationKalman, Sensitivities, tune_process_noise,
+    FullOrder, FullOrderGains, KalmanParams, ObserverParams, ReducedOrder, SaltationKalman,
+    Sensitivities, tune_process_noise,
 };
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
-use nalgebra::{SVector, Vector2};
+use nalgebra::{SMatrix, SVector, Vector2};
 use plotters::style::full_palette::{BLUE_700, GREEN_700, ORANGE_800, RED_600};
 use support::observe::{quantile, run, window};
 use support::plot::{Panel, Result, Series, announce, csv, figure};
@@ -191,11 +191,11 @@ where
         &u,
         (-4.0, 2.0),
     )?;
-    let accel_noise = tuned.params.accel_noise;
+    let knobs = tuned.params;
     println!();
     println!(
-        "{title}: median |v − v̂| over t ∈ [2, {T_END}] s, 1 kHz (filter: q_a = {:.2e} from 3 s of one σ = 1e-4 run)",
-        accel_noise[0]
+        "{title}: median |v − v̂| over t ∈ [2, {T_END}] s, 1 kHz (filter: q_a = {:.2e}, ρ_i = {:.2e}, σ_t = {:.2e}, ρ_c = {:.2e} from 3 s of one σ = 1e-4 run)",
+        knobs.accel_noise[0], knobs.impact_noise, knobs.impact_time_sigma, knobs.contact_noise
     );
     print!("  {:>8}", "σ");
     for name in ESTIMATORS {
@@ -205,8 +205,7 @@ where
     let mut rows = Vec::new();
     for (i, &sigma) in sigmas.iter().enumerate() {
         let reference = noisy(sigma, 31 + i as u64);
-        let medians =
-            estimate_all::<M, N, K>(model, &reference, sigma, velocity_bound, accel_noise)?;
+        let medians = estimate_all::<M, N, K>(model, &reference, sigma, velocity_bound, &knobs)?;
         print!("  {sigma:8.0e}");
         for m in &medians {
             print!("  {m:18.2e}");
@@ -250,12 +249,11 @@ fn estimate_all<M, const N: usize, const K: usize>(
     reference: &Reference<N>,
     sigma: f64,
     velocity_bound: f64,
-    accel_noise: SVector<f64, N>,
+    knobs: &KalmanParams<f64, N>,
 ) -> Result<[f64; 4]>
 where
     M: Sensitivities<N, K, Scalar = f64, Input = SVector<f64, 0>>,
 {
-    let u = SVector::<f64, 0>::zeros();
     let score = |v: &[SVector<f64, N>]| {
         let error: Vec<f64> = v
             .iter()
@@ -274,15 +272,17 @@ where
     let gains = FullOrderGains::scalar(5.0, 25.0);
     let mut full = FullOrder::<f64, N, K>::new(params, gains, t[0], q[0], SVector::zeros())?;
     let full = run::<_, _, N, K, 0>(model, &mut full, reference)?.v;
+    // the tuned process noise, told this run's σ
     let kalman_params = KalmanParams {
-        accel_noise,
-        ..KalmanParams::new(velocity_bound, sigma)
+        observer: ObserverParams {
+            noise: sigma,
+            ..knobs.observer
+        },
+        measurement: SMatrix::identity() * (sigma * sigma),
+        ..*knobs
     };
     let mut filter =
         SaltationKalman::<f64, N, K>::new(kalman_params, t[0], q[0], SVector::zeros())?;
-    let mut kalman = vec![SVector::zeros()];
-    for (tk, qk) in t.iter().zip(q).skip(1) {
-        kalman.push(filter.update(model, *tk, qk, &u)?.v);
-    }
+    let kalman = run::<_, _, N, K, 0>(model, &mut filter, reference)?.v;
     Ok([score(&fd), score(&reduced), score(&full), score(&kalman)])
 }
