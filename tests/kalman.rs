@@ -9,12 +9,11 @@
 
 use moreau::{
     Blocks, DataError, Estimate, IndexSet, KalmanParams, Lcp, Model, Observer, ObserverError,
-    ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, State, saltation,
-    tune_process_noise,
+    ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, saltation, tune_process_noise,
 };
 mod common;
 
-use common::runs::{Figures, Gauss, Reference, errors, figures, measure, reference, score};
+use common::runs::{Gauss, Reference, figures, measure, reference, score};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
 

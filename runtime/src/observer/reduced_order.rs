@@ -23,8 +23,32 @@ use crate::validate::{self, factor_mass, finite_model};
 /// give `+ l_d M ṽ dt`: see the module docs of
 /// `runtime/src/observer/mod.rs`).
 ///
-/// The state is `(t_k, q_k, v̂_k)`, fixed-size, on the stack; an update
-/// allocates nothing.
+/// The state is `(t_k, q_k, v̂_k)` (and `q̄_k` under noise, below),
+/// fixed-size, on the stack; an update allocates nothing.
+///
+/// # Under measurement noise
+///
+/// Told `σ > 0` ([`ObserverParams::with_noise`]), the observer locates
+/// impacts from a smoothed position instead of the raw sample: the
+/// predicted motion of each interval starts at `q̄_k`, the predicted end
+/// `p` of the last interval blended with the measurement, `q̄_{k+1} = p +
+/// β (q_{k+1} − p)`, `β = min(1, (4 l_d τ)^{2/3})`, held within the noise
+/// band `n_σ σ` of `q_{k+1}` in each coordinate. Its noise is `σ √(β/(2 −
+/// β))` (a third of `σ` at `l_d τ = 0.01`), and the contact rule (band,
+/// resting speed) of the interval uses that noise instead of `σ`. What is
+/// decided from `q̄`: where each gap closes inside the interval (a noisy
+/// start moves the located impact by `δh / v_n`, and the jump then by
+/// `(1 + e) A δh / v_n` with `A` the normal acceleration), whether a closed
+/// constraint is approached fast enough to bounce or is closed plastically,
+/// and the set `V(q̄_{k+1})` the estimate ends in.
+///
+/// The correction is unchanged: the injection is still the measured
+/// displacement minus the predicted one, `(q_{k+1} − q_k) − (p − q̄_k)`,
+/// times the gain of (38), so the error obeys the same `M dṽ = … − l_d M ṽ
+/// dt − (η − η̂)` and the guarantee (and the cost: one prediction per
+/// update) is kept; only where the impulse `η̂` acts moves, by at most the
+/// noise band. Without noise `q̄ = q` and the update is the one above, bit
+/// for bit.
 ///
 /// ```
 /// use moreau_runtime::{Model, ModelInfo, Observer, ObserverParams, ReducedOrder};
@@ -285,10 +309,8 @@ pub(crate) fn smoothed<T: RealField + Copy, const N: usize>(
 /// of the smoothed position, `σ √(β/(2 − β))` ([`smoothing`]); unchanged
 /// without noise or for a `τ` that is not positive (refused later).
 fn smoothed_noise<T: RealField + Copy>(params: &ObserverParams<T>, tau: T) -> ObserverParams<T> {
-    if params.noise == T::zero()
-        || !(tau > T::zero())
-        || params.scheme != Discretization::ImpactAware
-    {
+    let positive = tau > T::zero();
+    if params.noise == T::zero() || !positive || params.scheme != Discretization::ImpactAware {
         return *params;
     }
     let beta = smoothing(params, tau);
