@@ -9,12 +9,11 @@
 
 use moreau::{
     Blocks, DataError, Estimate, IndexSet, KalmanParams, Lcp, Model, Observer, ObserverError,
-    ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, State, saltation,
-    tune_process_noise,
+    ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, saltation, tune_process_noise,
 };
 mod common;
 
-use common::runs::{Figures, Gauss, Reference, errors, figures, measure, reference};
+use common::runs::{Gauss, Reference, figures, measure, reference, score};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
 
@@ -542,61 +541,6 @@ fn nis_and_nees_are_chi_square_where_the_noise_model_is_true() {
 // ---------------------------------------------------------------------------
 // Example 1 under noise
 
-/// Figures over `[2, 10]` s: all samples, and without the two samples that
-/// bracket each plant impact (the last before it, the first after it).
-struct Scored {
-    all: Figures,
-    clean: Figures,
-    /// Samples after each plant impact (past 2 s) until `|v − v̂| < 1e-2`.
-    recover: Vec<usize>,
-}
-
-fn score<const N: usize>(data: &Reference<N>, estimates: &[Estimate<f64, N>]) -> Scored {
-    let errors = errors(data, estimates);
-    let mut bracket = vec![false; errors.len()];
-    let mut recover = Vec::new();
-    for &(t, _, _) in &data.impacts {
-        let first = data
-            .samples
-            .iter()
-            .position(|s| s.t >= t - 1e-12)
-            .unwrap_or(errors.len());
-        if first < errors.len() {
-            bracket[first] = true;
-        }
-        if first > 0 {
-            bracket[first - 1] = true;
-        }
-        if t >= 2.0 {
-            let back = (first..errors.len())
-                .find(|&j| errors[j] < 1e-2)
-                .map_or(usize::MAX, |j| j - first);
-            recover.push(back);
-        }
-    }
-    let in_window = |s: &State<f64, N>| s.t >= 2.0 - 1e-9 && s.t < 10.0 + 1e-3 - 1e-9;
-    let all: Vec<f64> = data
-        .samples
-        .iter()
-        .zip(&errors)
-        .filter(|(s, _)| in_window(s))
-        .map(|(_, &e)| e)
-        .collect();
-    let clean: Vec<f64> = data
-        .samples
-        .iter()
-        .zip(&errors)
-        .zip(&bracket)
-        .filter(|((s, _), b)| in_window(s) && !**b)
-        .map(|((_, &e), _)| e)
-        .collect();
-    Scored {
-        all: figures(&all),
-        clean: figures(&clean),
-        recover,
-    }
-}
-
 /// The process noise for Example 1 picked by [`tune_process_noise`] from
 /// one recorded noisy run (the model file's initial state, its own noise
 /// seed), used unchanged on every other run.
@@ -672,7 +616,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros())
                     .unwrap();
             let est = run(&mut f, &model, &data, &measured, &u);
-            let sc = score(&data, &est);
+            let sc = score(&data, &est, (2.0, 10.0 + 1e-3));
             let mut o = ReducedOrder::<f64, 2, 2>::new(
                 ObserverParams::new(10.0, 20.0).with_noise(sigma),
                 0.0,
@@ -681,7 +625,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
             )
             .unwrap();
             let obs = run(&mut o, &model, &data, &measured, &u);
-            let so = score(&data, &obs);
+            let so = score(&data, &obs, (2.0, 10.0 + 1e-3));
             eprintln!(
                 "Example 1, start {n}, σ = {sigma:e}: filter median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e}; samples to recover, worst {}), (38) median {:.2e} p90 {:.2e} max {:.2e}",
                 sc.all.median,

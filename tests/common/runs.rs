@@ -138,3 +138,58 @@ pub fn figures(errors: &[f64]) -> Figures {
         max: sorted[n - 1],
     }
 }
+
+/// The error figures of one run over `t ∈ [from, to)`: all samples, the
+/// samples that do not bracket a plant impact (the last before it and the
+/// first after it), and after each plant impact at `t ≥ from` the samples
+/// until `|v − v̂| < 1e-2` (`usize::MAX` for never).
+#[derive(Clone, Debug)]
+pub struct Scored {
+    pub all: Figures,
+    pub clean: Figures,
+    pub recover: Vec<usize>,
+}
+
+pub fn score<const N: usize>(
+    data: &Reference<N>,
+    estimates: &[Estimate<f64, N>],
+    (from, to): (f64, f64),
+) -> Scored {
+    let errors = errors(data, estimates);
+    let mut bracket = vec![false; errors.len()];
+    let mut recover = Vec::new();
+    for &(t, _, _) in &data.impacts {
+        let first = data
+            .samples
+            .iter()
+            .position(|s| s.t >= t - 1e-12)
+            .unwrap_or(errors.len());
+        if first < errors.len() {
+            bracket[first] = true;
+        }
+        if first > 0 {
+            bracket[first - 1] = true;
+        }
+        if t >= from {
+            let back = (first..errors.len())
+                .find(|&j| errors[j] < 1e-2)
+                .map_or(usize::MAX, |j| j - first);
+            recover.push(back);
+        }
+    }
+    let in_window = |s: &State<f64, N>| s.t >= from - 1e-9 && s.t < to - 1e-9;
+    let pick = |skip_brackets: bool| -> Vec<f64> {
+        data.samples
+            .iter()
+            .zip(&errors)
+            .zip(&bracket)
+            .filter(|((s, _), b)| in_window(s) && !(skip_brackets && **b))
+            .map(|((_, &e), _)| e)
+            .collect()
+    };
+    Scored {
+        all: figures(&pick(false)),
+        clean: figures(&pick(true)),
+        recover,
+    }
+}

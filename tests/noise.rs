@@ -1,0 +1,152 @@
+//! The reduced-order observer (38) under measurement noise: Gaussian
+//! noise of standard deviation `σ = 1e-4` m on each measured coordinate at
+//! 1 kHz, the observer told `σ` (`ObserverParams::with_noise`), on plant
+//! runs at τ = 1e-5 (`tests/common/runs.rs`), `v̂(0) = 0`, scored over
+//! `t ∈ [2, 10]` s.
+//!
+//! Run with `cargo test --release --test noise -- --nocapture` to see every
+//! figure.
+
+use moreau::{Estimate, Model, Observer, ObserverParams, ReducedOrder};
+mod common;
+
+use common::runs::{Reference, Scored, measure, reference, score};
+use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
+use nalgebra::{SVector, Vector2};
+
+/// (38) with `l_d = 10`, `C_v = 20`, told `σ`, from the first measurement
+/// and `v̂(0) = 0`; returns the estimates, the initial one first.
+fn run<M, const N: usize, const K: usize>(
+    model: &M,
+    data: &Reference<N>,
+    measured: &[SVector<f64, N>],
+    sigma: f64,
+) -> Vec<Estimate<f64, N>>
+where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>>,
+{
+    let u = SVector::zeros();
+    let params = ObserverParams::new(10.0, 20.0).with_noise(sigma);
+    let mut o = ReducedOrder::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros()).unwrap();
+    let mut out = vec![o.estimate()];
+    for (s, q) in data.samples.iter().zip(measured).skip(1) {
+        out.push(o.update(model, s.t, q, &u).unwrap());
+    }
+    out
+}
+
+fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
+    vec![
+        Parabola::<f64>::initial_state(),
+        (Vector2::new(-1.0, 3.0), Vector2::new(-2.0, 5.0)),
+        (Vector2::new(0.5, 6.0), Vector2::new(4.0, 0.0)),
+        (Vector2::new(0.2, 1.0), Vector2::new(1.0, -2.0)),
+    ]
+}
+
+fn show(name: &str, s: &Scored) {
+    eprintln!(
+        "{name}: median {:.2e} p90 {:.2e} max {:.2e}, without the bracketing samples max {:.2e}; samples to |ṽ| < 1e-2 after each impact: worst {} of {:?}",
+        s.all.median,
+        s.all.p90,
+        s.all.max,
+        s.clean.max,
+        s.recover.iter().max().unwrap_or(&0),
+        s.recover
+    );
+}
+
+/// `√2 l_d σ`: the scale of the noise the injection passes (see
+/// `noise_sets_the_error_level` in `tests/observer.rs`).
+const NOISE_SCALE: f64 = std::f64::consts::SQRT_2 * 10.0 * 1e-4;
+
+/// Runs one model on the seeds and checks every run's figures: median at
+/// most `median` × √2 l_d σ, 90th percentile at most `p90` ×, and without
+/// the samples bracketing a plant impact a maximum of at most `clean`.
+/// Prints every run first, then asserts.
+fn check<M, const N: usize, const K: usize>(
+    name: &str,
+    model: &M,
+    start: (SVector<f64, N>, SVector<f64, N>),
+    seeds: &[u64],
+    (median, p90, clean): (f64, f64, f64),
+) where
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>>,
+{
+    let sigma = 1e-4;
+    let data = reference(model, start, 1e-5, 100, 10.0, &SVector::zeros());
+    let mut failed = Vec::new();
+    for &seed in seeds {
+        let measured = measure(&data, sigma, seed);
+        let est = run::<_, N, K>(model, &data, &measured, sigma);
+        let s = score(&data, &est, (2.0, 10.0 + 1e-3));
+        show(&format!("{name}, seed {seed}"), &s);
+        if s.all.median > median * NOISE_SCALE
+            || s.all.p90 > p90 * NOISE_SCALE
+            || s.clean.max > clean
+        {
+            failed.push((seed, s));
+        }
+    }
+    assert!(failed.is_empty(), "{name}: {failed:?}");
+}
+
+/// Example 1 on four starts (the model file's, whose impacts accumulate
+/// at 4.456 s before it slides, and three more), each with the noise seed
+/// the observer was developed on (`11 + n`, as in `tests/kalman.rs`) and
+/// two seeds it never saw (`7001 + n`, `9001 + n`).
+///
+/// Baseline, measured on main before the smoothed position (the observer
+/// predicting from the raw `q_k`) on these twelve runs: median 1.21e-3 to
+/// 1.95e-3 (0.86 to 1.38 × √2 l_d σ), 90th percentile 2.19e-3 to 4.23e-3
+/// (1.55 to 2.99 ×), maximum 4.8e-3 to 3.8 m/s, and without the two
+/// samples that bracket each plant impact 4.8e-3 to 0.40 m/s (worst per
+/// start over the seeds: 0.40, 0.17, 0.0056, 0.31), with the error above
+/// 1e-2 for up to 94 samples after an impact of the accumulation.
+///
+/// Asserted on every run: median and 90th percentile within the baseline's
+/// worst (`1.4` and `3` × √2 l_d σ), and without the bracketing samples a
+/// maximum of at most `0.3` m/s. The target for that maximum,
+/// `0.1` m/s, is not reached on every run: see the figures printed.
+#[test]
+fn example_1_under_noise() {
+    let model = Parabola::<f64>::new();
+    for (n, start) in example_1_starts().into_iter().enumerate() {
+        let seeds = [11, 7001, 9001].map(|s| s + n as u64);
+        check::<_, 2, 2>(
+            &format!("Example 1, start {n}"),
+            &model,
+            start,
+            &seeds,
+            (1.4, 3.0, 0.3),
+        );
+    }
+}
+
+/// The same on models the smoothing was not developed on, with seeds it
+/// never saw: the three balls (a glued pair, simultaneous impacts) and the
+/// double pendulum (configuration-dependent `M`, damping, a tip hitting a
+/// wall and a floor).
+///
+/// Baseline on main (these seeds): three balls median 1.94e-3 to 1.98e-3,
+/// 90th percentile 3.43e-3 to 3.51e-3, without the bracketing samples max
+/// 5.3e-2; double pendulum median 2.30e-3 to 2.34e-3 (1.65 ×), 90th
+/// percentile 3.90e-3 to 4.02e-3 (2.84 ×), without the bracketing samples
+/// max 0.11 to 0.18. Asserted: median and 90th percentile within `1.7` and
+/// `3` × √2 l_d σ, and without the bracketing samples a maximum of at most
+/// `0.1` m/s.
+#[test]
+fn other_models_under_noise() {
+    let balls = ThreeBalls::<f64>::new();
+    let start = ThreeBalls::<f64>::initial_state();
+    check::<_, 3, 4>("three balls", &balls, start, &[7001, 9001], (1.7, 3.0, 0.1));
+    let pendulum = DoublePendulum::<f64>::new();
+    let start = DoublePendulum::<f64>::initial_state();
+    check::<_, 2, 2>(
+        "double pendulum",
+        &pendulum,
+        start,
+        &[7001, 9001],
+        (1.7, 3.0, 0.1),
+    );
+}
