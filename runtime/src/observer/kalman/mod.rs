@@ -330,7 +330,7 @@ impl<T: RealField + Copy> KalmanReport<T> {
 /// model's [`Sensitivities`] (every `model!` type has them).
 ///
 /// ```
-/// use moreau_runtime::{KalmanParams, Model, ModelInfo, SaltationKalman, Sensitivities};
+/// use moreau_runtime::{KalmanParams, Model, ModelInfo, Observer, SaltationKalman, Sensitivities};
 /// use nalgebra::{Matrix1, SVector, Vector1};
 ///
 /// /// A unit ball above the floor y ≥ 0, e = 0.8.
