@@ -13,7 +13,7 @@ use moreau::{
 };
 mod common;
 
-use common::runs::{Gauss, Reference, figures, measure, reference, score};
+use common::runs::{Gauss, Reference, example_1_starts, figures, measure, reference, score};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
 
@@ -43,17 +43,6 @@ where
         );
     }
     estimates
-}
-
-/// Example 1's initial states: the model file's (impacts accumulate at
-/// 4.456 s and the mass slides on), and three more.
-fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
-    vec![
-        Parabola::<f64>::initial_state(),
-        (Vector2::new(-1.0, 3.0), Vector2::new(-2.0, 5.0)),
-        (Vector2::new(0.5, 6.0), Vector2::new(4.0, 0.0)),
-        (Vector2::new(0.2, 1.0), Vector2::new(1.0, -2.0)),
-    ]
 }
 
 // ---------------------------------------------------------------------------

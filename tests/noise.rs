@@ -10,9 +10,9 @@
 use moreau::{Estimate, Model, Observer, ObserverParams, ReducedOrder};
 mod common;
 
-use common::runs::{Reference, Scored, measure, reference, score};
+use common::runs::{Reference, Scored, example_1_starts, measure, reference, score};
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
-use nalgebra::{SVector, Vector2};
+use nalgebra::SVector;
 
 /// (38) with `l_d = 10`, `C_v = 20`, told `σ`, from the first measurement
 /// and `v̂(0) = 0`; returns the estimates, the initial one first.
@@ -33,15 +33,6 @@ where
         out.push(o.update(model, s.t, q, &u).unwrap());
     }
     out
-}
-
-fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
-    vec![
-        Parabola::<f64>::initial_state(),
-        (Vector2::new(-1.0, 3.0), Vector2::new(-2.0, 5.0)),
-        (Vector2::new(0.5, 6.0), Vector2::new(4.0, 0.0)),
-        (Vector2::new(0.2, 1.0), Vector2::new(1.0, -2.0)),
-    ]
 }
 
 fn show(name: &str, s: &Scored) {

@@ -3,7 +3,8 @@
 //! figures (`tests/observer.rs`, `tests/kalman.rs`).
 
 use moreau::{Estimate, Model, MoreauJean, State, StepParams};
-use nalgebra::SVector;
+use moreau_models::Parabola;
+use nalgebra::{SVector, Vector2};
 
 /// A plant trajectory sampled for an observer.
 pub struct Reference<const N: usize> {
@@ -192,4 +193,15 @@ pub fn score<const N: usize>(
         clean: figures(&pick(true)),
         recover,
     }
+}
+
+/// Example 1's initial states: the model file's (impacts accumulate at
+/// 4.456 s and the mass slides on), and three more.
+pub fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
+    vec![
+        Parabola::<f64>::initial_state(),
+        (Vector2::new(-1.0, 3.0), Vector2::new(-2.0, 5.0)),
+        (Vector2::new(0.5, 6.0), Vector2::new(4.0, 0.0)),
+        (Vector2::new(0.2, 1.0), Vector2::new(1.0, -2.0)),
+    ]
 }
