@@ -49,7 +49,7 @@ mod lincomb;
 
 pub use layout::{Layout, Quantity, Slot};
 
-use crate::graph::Graph;
+use crate::graph::{Graph, TrigForm};
 use crate::node::{Id, VarId};
 use lincomb::{lincomb, sum};
 
@@ -247,7 +247,8 @@ impl Mechanics {
         // dm[i][j][k] = ∂M_ij/∂q_k, shared by C and ∂(M v)/∂q.
         let dm = mass_derivatives(g, sys, &mass);
         let coriolis = coriolis(g, sys, &dm);
-        let gravity = g.gradient(sys.potential, sys.q);
+        let potential = TrigForm::new().normal(g, sys.potential);
+        let gravity = g.gradient(potential, sys.q);
         let forces = total_forces(g, sys, &coriolis, &gravity);
         let jacobian = g.jacobian(sys.gaps, sys.q);
         let force_dq = g.jacobian(&forces, sys.q);
@@ -347,6 +348,7 @@ fn mass_matrix(
     let n = sys.q.len();
     let zero = g.constant(0.0);
     let momentum = g.gradient(sys.kinetic, sys.v);
+    let mut trig = TrigForm::new();
     let mut mass = vec![vec![zero; n]; n];
     for (i, &p) in momentum.iter().enumerate() {
         for j in i..n {
@@ -358,6 +360,7 @@ fn mass_matrix(
                     velocity: k,
                 });
             }
+            let m = trig.normal(g, m);
             mass[i][j] = m;
             mass[j][i] = m;
         }
