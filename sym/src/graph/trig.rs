@@ -35,7 +35,7 @@ use crate::node::{Func, Id, Node};
 
 /// The largest number of monomials of any intermediate form; past it the
 /// normal form is abandoned.
-pub const MAX_TERMS: usize = 400;
+pub(crate) const MAX_TERMS: usize = 400;
 
 /// The largest power expanded (`x^4` is `x·x·x·x`; `x^5` stays an atom).
 const MAX_POWER: i32 = 4;
@@ -84,8 +84,10 @@ impl TrigForm {
         TrigForm::default()
     }
 
-    /// `e` in the normal form of the [module docs](self), or `e` itself when
-    /// the form would exceed [`MAX_TERMS`] monomials.
+    /// `e` in the trigonometric normal form (a sum of monomials in its
+    /// non-trigonometric factors times `cos` or `sin` of an integer
+    /// combination of angles, rebuilt with common factors pulled out), or
+    /// `e` itself when some subexpression's form would exceed 400 monomials.
     ///
     /// ```
     /// use moreau_sym::{graph::TrigForm, Graph, VarId};

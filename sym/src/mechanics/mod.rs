@@ -16,6 +16,12 @@
 //! With the Christoffel symbols `Γ`, `Ṁ − 2C` is skew-symmetric, which the
 //! observers' passivity argument needs.
 //!
+//! Each `M_ij` and `V` are put in the trigonometric normal form of
+//! [`TrigForm`] before they are differentiated, so that `sin² + cos²` of an
+//! angle cancels and products of `sin`/`cos` become waves of angle sums and
+//! differences: a chain's `M` depends on differences of its absolute angles
+//! only, or not on its first relative angle.
+//!
 //! # Work sharing
 //!
 //! `T` is differentiated once per velocity (`p`), and `M` is differentiated
