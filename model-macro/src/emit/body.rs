@@ -313,11 +313,12 @@ impl Builder<'_, '_> {
     /// Binds `sin a` and `cos a` by one `let (sin, cos) = a.sin_cos();`
     /// and returns the code that reads each.
     fn bind_sin_cos(&mut self, a: Code) -> (Code, Code) {
-        let [sin, cos] = [Func::Sin, Func::Cos].map(|f| {
-            role(&Code::Func(f, Box::new(a.clone()))).unwrap_or_else(|| {
+        let [sin, cos] = [Func::Sin, Func::Cos].map(|f| match a {
+            Code::Local(Local::Temp(i)) => Local::TempFunc(f, i),
+            _ => role(&Code::Func(f, Box::new(a.clone()))).unwrap_or_else(|| {
                 self.temps += 1;
                 Local::Temp(self.temps - 1)
-            })
+            }),
         });
         for local in [sin, cos] {
             let readable = local.readable(self.model, 0.0);
