@@ -101,11 +101,9 @@ fn row(name: &str, t: [f64; 4], seconds: f64) -> String {
 
 /// On every shipped model each proven bound encloses the sampled estimate
 /// (`λ_min` proven ≤ sampled, the others ≥), and is within 20 % of it with
-/// the default budget, except on the three-link arm, which misses it (its
-/// row is printed, not asserted; see the README: its `λ_min` is 1/360 of
-/// its `λ_max`, and its generated `M` and `C` carry `sin² + cos²` of the
-/// absolute link angles, which intervals do not cancel). Prints the
-/// README's table.
+/// the default budget (the three-link arm too, since its `M` is generated
+/// in the trigonometric normal form, free of `q1`). Prints the README's
+/// table.
 #[test]
 fn proven_bounds_enclose_the_sampled_estimates_within_20_percent() {
     let zero2 = SVector::<f64, 0>::zeros();
@@ -155,7 +153,7 @@ fn proven_bounds_enclose_the_sampled_estimates_within_20_percent() {
     for r in &rows {
         eprintln!("{r}");
     }
-    for r in rows.iter().filter(|r| !r.contains("Arm3")) {
+    for r in &rows {
         let ratios: Vec<f64> = r
             .split('|')
             .skip(2)

@@ -48,6 +48,12 @@ pub trait Enclose:
     /// `cos(self)`.
     #[must_use]
     fn cos(self) -> Self;
+    /// `(sin(self), cos(self))`, the pair the generated code asks for when
+    /// it needs both.
+    #[must_use]
+    fn sin_cos(self) -> (Self, Self) {
+        (self.sin(), self.cos())
+    }
     /// `tan(self)`.
     #[must_use]
     fn tan(self) -> Self;

@@ -42,7 +42,7 @@
 //! let names = |v: VarId| ["th", "w", "m", "l", "g"][v.index()].to_string();
 //! assert_eq!(
 //!     sched.listing(&names),
-//!     "t0 = powi(l, 2)\nt1 = t0 * m\nt2 = m * g\nt3 = t2 * l\nt4 = sin(th)\nt5 = t3 * t4\n\
+//!     "t0 = powi(l, 2)\nt1 = t0 * m\nt2 = m * l\nt3 = t2 * g\nt4 = sin(th)\nt5 = t3 * t4\n\
 //!      out[0] = t1\nout[1] = 0.0\nout[2] = t5\nout[3] = t5\n"
 //! );
 //! ```

@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use moreau_sym::{Func, Layout, Op, Operand, Schedule, VarId};
+use moreau_sym::{Func, Layout, Op, Operand, Schedule, Slot, VarId};
 
 use super::names::{Local, Names, Role};
 use crate::resolve::{Resolved, VarLayout};
@@ -32,6 +32,9 @@ pub(crate) enum Code {
     Powi(Box<Code>, i32),
     /// `a.sin()`: the scalar's method of the function's name.
     Func(Func, Box<Code>),
+    /// `a.sin_cos()`, the pair `(sin a, cos a)`, bound by a [`Let`] with a
+    /// [`pair`](Let::pair).
+    SinCos(Box<Code>),
     /// `a.powf(b)`.
     Powf(Box<Code>, Box<Code>),
     /// `y.atan2(x)`.
@@ -54,7 +57,7 @@ impl Code {
     pub fn depth(&self) -> usize {
         match self {
             Code::Local(_) => 1,
-            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) => 1 + a.depth(),
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) | Code::SinCos(a) => 1 + a.depth(),
             Code::Binary(_, a, b) | Code::Powf(a, b) | Code::Atan2(a, b) => {
                 1 + a.depth().max(b.depth())
             }
@@ -65,7 +68,9 @@ impl Code {
     pub fn visit_locals(&self, f: &mut impl FnMut(Local)) {
         match self {
             Code::Local(l) => f(*l),
-            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) => a.visit_locals(f),
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) | Code::SinCos(a) => {
+                a.visit_locals(f)
+            }
             Code::Binary(_, a, b) | Code::Powf(a, b) | Code::Atan2(a, b) => {
                 a.visit_locals(f);
                 b.visit_locals(f);
@@ -82,7 +87,7 @@ impl Code {
                 a.visit_vars(f);
                 b.visit_vars(f);
             }
-            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) => a.visit_vars(f),
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) | Code::SinCos(a) => a.visit_vars(f),
             Code::Powf(a, b) | Code::Atan2(a, b) => {
                 a.visit_vars(f);
                 b.visit_vars(f);
@@ -92,11 +97,13 @@ impl Code {
 }
 
 /// One `let` of a body: the local, its value and, for an output, the entry
-/// it is (for the listing's comment).
+/// it is (for the listing's comment). With a `pair`, the binding is
+/// `let (local, pair) = code;` (a [`Code::SinCos`]).
 pub(crate) struct Let {
     pub local: Local,
     pub code: Code,
     pub entry: Option<String>,
+    pub pair: Option<Local>,
 }
 
 /// A method body.
@@ -139,7 +146,24 @@ pub(crate) fn build(
             output_of[t as usize].get_or_insert(outputs.slot(index));
         }
     }
+    let partner = sin_cos_partners(&sched, &output_of);
+    let mut pending: HashMap<usize, Code> = HashMap::new();
     for (k, instr) in sched.instrs.iter().enumerate() {
+        if let Some(code) = pending.remove(&k) {
+            b.codes.push(Some(code));
+            continue;
+        }
+        if let Some(p) = partner[k] {
+            let a = b.operand(instr.args[0]);
+            let (sin, cos) = b.bind_sin_cos(a);
+            let (mine, theirs) = match instr.op {
+                Op::Func(Func::Sin) => (sin, cos),
+                _ => (cos, sin),
+            };
+            pending.insert(p, theirs);
+            b.codes.push(Some(mine));
+            continue;
+        }
         let a = Box::new(b.operand(instr.args[0]));
         let mut second = || Box::new(b.operand(instr.args[1]));
         let code = match instr.op {
@@ -168,14 +192,7 @@ pub(crate) fn build(
         b.codes.push(Some(code));
     }
     let outputs: Vec<Code> = sched.outputs.iter().map(|&o| b.operand(o)).collect();
-    let mut read = vec![false; b.vars.len()];
-    for code in b.lets.iter().map(|l| &l.code).chain(&outputs) {
-        code.visit_vars(&mut |v| read[b.vars.id(v).index()] = true);
-    }
-    let unpack = (0..b.vars.len())
-        .filter(|&i| read[i])
-        .map(|i| b.vars.var(VarId(i as u32)))
-        .collect();
+    let unpack = read_vars(&b, &outputs);
     Body {
         unpack,
         constants: b.constants,
@@ -183,6 +200,46 @@ pub(crate) fn build(
         outputs,
         names: b.names,
     }
+}
+
+/// The model variables the lets and outputs read, in layout order.
+fn read_vars(b: &Builder<'_, '_>, outputs: &[Code]) -> Vec<Var> {
+    let mut read = vec![false; b.vars.len()];
+    for code in b.lets.iter().map(|l| &l.code).chain(outputs) {
+        code.visit_vars(&mut |v| read[b.vars.id(v).index()] = true);
+    }
+    (0..b.vars.len())
+        .filter(|&i| read[i])
+        .map(|i| b.vars.var(VarId(i as u32)))
+        .collect()
+}
+
+/// For the first of two instructions `sin a` and `cos a` of one operand,
+/// neither of them an output, the index of the other (computed together by
+/// one `sin_cos`).
+fn sin_cos_partners(sched: &Schedule, output_of: &[Option<Slot>]) -> Vec<Option<usize>> {
+    let key = |a: Operand| match a {
+        Operand::Var(v) => Some((0, v.0)),
+        Operand::Tmp(t) => Some((1, t)),
+        Operand::Const(_) => None,
+    };
+    let mut seen: HashMap<(Func, (u8, u32)), usize> = HashMap::new();
+    let mut partner = vec![None; sched.instrs.len()];
+    for (k, instr) in sched.instrs.iter().enumerate() {
+        let (Op::Func(f @ (Func::Sin | Func::Cos)), Some(a), None) =
+            (instr.op, key(instr.args[0]), output_of[k])
+        else {
+            continue;
+        };
+        let other = if f == Func::Sin { Func::Cos } else { Func::Sin };
+        match seen.get(&(other, a)) {
+            Some(&first) if partner[first].is_none() => partner[first] = Some(k),
+            _ => {
+                seen.entry((f, a)).or_insert(k);
+            }
+        }
+    }
+    partner
 }
 
 /// A role for a shared temporary that is a function of one variable.
@@ -244,7 +301,35 @@ impl Builder<'_, '_> {
     fn bind(&mut self, local: Local, code: Code, entry: Option<String>) -> Code {
         let readable = local.readable(self.model, 0.0);
         self.names.declare(local, readable);
-        self.lets.push(Let { local, code, entry });
+        self.lets.push(Let {
+            local,
+            code,
+            entry,
+            pair: None,
+        });
         Code::Local(local)
+    }
+
+    /// Binds `sin a` and `cos a` by one `let (sin, cos) = a.sin_cos();`
+    /// and returns the code that reads each.
+    fn bind_sin_cos(&mut self, a: Code) -> (Code, Code) {
+        let [sin, cos] = [Func::Sin, Func::Cos].map(|f| match a {
+            Code::Local(Local::Temp(i)) => Local::TempFunc(f, i),
+            _ => role(&Code::Func(f, Box::new(a.clone()))).unwrap_or_else(|| {
+                self.temps += 1;
+                Local::Temp(self.temps - 1)
+            }),
+        });
+        for local in [sin, cos] {
+            let readable = local.readable(self.model, 0.0);
+            self.names.declare(local, readable);
+        }
+        self.lets.push(Let {
+            local: sin,
+            code: Code::SinCos(Box::new(a)),
+            entry: None,
+            pair: Some(cos),
+        });
+        (Code::Local(sin), Code::Local(cos))
     }
 }

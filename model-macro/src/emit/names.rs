@@ -32,6 +32,9 @@ pub(crate) enum Local {
     Role(Role, Var),
     /// The `i`-th anonymous shared temporary (`a0`, `a1`, ...).
     Temp(usize),
+    /// `sin` or `cos` of the `i`-th temporary (`sin_a1`), bound by a
+    /// `sin_cos`.
+    TempFunc(Func, usize),
 }
 
 /// What a role local computes from its variable.
@@ -64,6 +67,7 @@ impl Local {
             Local::Role(Role::Square, var) => format!("{}_sq", model.var_name(var)),
             Local::Role(Role::Cube, var) => format!("{}_cube", model.var_name(var)),
             Local::Temp(i) => format!("a{i}"),
+            Local::TempFunc(f, i) => format!("{}_a{i}", f.name()),
         }
     }
 }

@@ -34,7 +34,8 @@ pub(crate) trait Sink {
     fn cst(&mut self, x: f64);
     /// An integer literal.
     fn int(&mut self, n: i32);
-    /// A binary operator `+ - * /`, or unary `-` when `unary`.
+    /// A binary operator `+ - * /`, unary `-` when `unary`, or the comma
+    /// between the names of a tuple.
     fn op(&mut self, op: char, unary: bool);
     /// `.name(` args `)`.
     fn method(&mut self, name: &str, args: &mut dyn FnMut(&mut Self));
@@ -89,6 +90,10 @@ pub(crate) fn code<S: Sink>(s: &mut S, names: &Names, model: &Resolved<'_>, code
         Code::Func(f, a) => {
             operand(s, a, a.precedence() < 4);
             s.method(f.name(), &mut |_| {});
+        }
+        Code::SinCos(a) => {
+            operand(s, a, a.precedence() < 4);
+            s.method("sin_cos", &mut |_| {});
         }
         Code::Powf(a, b) | Code::Atan2(a, b) => {
             let name = if matches!(code, Code::Powf(..)) {
@@ -152,8 +157,16 @@ pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) 
 fn lets<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body, lets: &[Let]) {
     for l in lets {
         let name = body.names.get(l.local);
+        let pair = l.pair.map(|p| body.names.get(p));
         s.binding(
-            &mut |s| s.internal(name),
+            &mut |s| match pair {
+                Some(second) => s.paren(&mut |s| {
+                    s.internal(name);
+                    s.op(',', false);
+                    s.internal(second);
+                }),
+                None => s.internal(name),
+            },
             false,
             &mut |s| code(s, &body.names, model, &l.code),
             l.entry.as_deref(),
@@ -183,7 +196,11 @@ fn parts(body: &Body) -> Vec<Part> {
         .lets
         .iter()
         .enumerate()
-        .map(|(i, l)| (l.local, i / PART))
+        .flat_map(|(i, l)| {
+            core::iter::once(l.local)
+                .chain(l.pair)
+                .map(move |local| (local, i / PART))
+        })
         .collect();
     let count = body.lets.len().div_ceil(PART);
     let mut live_in: Vec<Vec<Local>> = vec![Vec::new(); count];
@@ -426,7 +443,9 @@ impl Sink for Text {
         self.0.push_str(&n.to_string());
     }
     fn op(&mut self, op: char, unary: bool) {
-        if unary {
+        if op == ',' {
+            self.0.push_str(", ");
+        } else if unary {
             self.0.push(op);
         } else {
             self.0.push_str(&format!(" {op} "));

@@ -93,3 +93,47 @@ fn output_entries_are_named_after_their_slot() {
         assert_eq!(name(g1), "g_1");
     });
 }
+
+/// CasADi's operation count for a model, from the JSON its reference script
+/// wrote (`casadi_op_count`).
+fn casadi_ops(json: &str) -> usize {
+    let text = std::fs::read_to_string(json).unwrap();
+    let key = "\"casadi_op_count\":";
+    let at = text.find(key).unwrap() + key.len();
+    let digits: String = text[at..]
+        .trim_start()
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    digits.parse().unwrap()
+}
+
+/// The fused evaluation (M, C, G, F, h, J) counts at most as many operations
+/// as CasADi's generated C for the same model (`tests/casadi_reference.py`,
+/// SX with CSE), on every shipped model and the planar chains N = 2..12.
+#[test]
+fn op_counts_at_most_casadis() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut cases: Vec<(String, String)> = SHIPPED
+        .iter()
+        .map(|s| (s.to_string(), format!("tests/fixtures/casadi/{s}.json")))
+        .collect();
+    for n in 2..=12 {
+        cases.push((
+            format!("chains/chain{n:02}"),
+            format!("benches/casadi/chains/chain{n:02}.json"),
+        ));
+    }
+    let mut over = Vec::new();
+    for (stem, json) in cases {
+        let ours = shipped(&stem, |model, lowered| {
+            Emitter::new(model, lowered).op_count()
+        });
+        let theirs = casadi_ops(root.join(json).to_str().unwrap());
+        eprintln!("{stem}: moreau {ours}, CasADi {theirs}");
+        if ours > theirs {
+            over.push((stem, ours, theirs));
+        }
+    }
+    assert!(over.is_empty(), "more operations than CasADi: {over:?}");
+}

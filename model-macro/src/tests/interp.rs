@@ -108,10 +108,20 @@ impl Methods {
         for stmt in &f.block.stmts {
             match stmt {
                 Stmt::Local(l) => {
-                    let n = pat_name(&l.pat).ok_or("unsupported pattern")?;
                     let init = l.init.as_ref().ok_or("let without a value")?;
                     let v = env.eval(&init.expr)?;
-                    env.lets.push((n, v));
+                    match (&l.pat, v) {
+                        (Pat::Tuple(t), Value::Tuple(vs)) if t.elems.len() == vs.len() => {
+                            for (p, v) in t.elems.iter().zip(vs) {
+                                let n = pat_name(p).ok_or("unsupported pattern")?;
+                                env.lets.push((n, v));
+                            }
+                        }
+                        (pat, v) => {
+                            let n = pat_name(pat).ok_or("unsupported pattern")?;
+                            env.lets.push((n, v));
+                        }
+                    }
                 }
                 Stmt::Expr(e, None) => last = Some(env.eval(e)?),
                 _ => return Err("unsupported statement".into()),
@@ -250,6 +260,7 @@ impl Env<'_> {
         match (method.as_str(), args.as_slice()) {
             ("sin", []) => one(f64::sin),
             ("cos", []) => one(f64::cos),
+            ("sin_cos", []) => Ok(Value::Tuple(vec![Value::Num(x.sin()), Value::Num(x.cos())])),
             ("tan", []) => one(f64::tan),
             ("sqrt", []) => one(f64::sqrt),
             ("exp", []) => one(f64::exp),

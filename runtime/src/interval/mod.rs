@@ -88,6 +88,7 @@ pub const LIBM_ULPS: u32 = 4;
 /// The next `f64` above `x` (`x` itself for `+∞` and NaN): `f64::next_up`,
 /// written out for Rust 1.85.
 #[must_use]
+#[inline]
 pub fn next_up(x: f64) -> f64 {
     if x.is_nan() || x == f64::INFINITY {
         return x;
@@ -101,6 +102,7 @@ pub fn next_up(x: f64) -> f64 {
 
 /// The next `f64` below `x` (`x` itself for `−∞` and NaN).
 #[must_use]
+#[inline]
 pub fn next_down(x: f64) -> f64 {
     -next_up(-x)
 }
@@ -120,6 +122,7 @@ fn down_by(mut x: f64, ulps: u32) -> f64 {
 }
 
 /// `a + b` rounded toward `−∞` (TwoSum: stepped only when inexact downward).
+#[inline]
 pub(crate) fn add_down(a: f64, b: f64) -> f64 {
     let s = a + b;
     if !s.is_finite() {
@@ -131,11 +134,13 @@ pub(crate) fn add_down(a: f64, b: f64) -> f64 {
 }
 
 /// `a + b` rounded toward `+∞`.
+#[inline]
 pub(crate) fn add_up(a: f64, b: f64) -> f64 {
     -add_down(-a, -b)
 }
 
 /// Veltkamp's split of `a` into two halves of 26 bits each.
+#[inline]
 fn split(a: f64) -> (f64, f64) {
     let c = 134_217_729.0 * a; // 2^27 + 1
     let h = c - (c - a);
@@ -146,6 +151,7 @@ fn split(a: f64) -> (f64, f64) {
 /// (`exact − rounded`): Dekker's TwoProduct, exact when no partial product
 /// overflows or underflows; outside `2^−900 ≤ |a·b|`, `|a|, |b| ≤ 2^900` the
 /// sign is reported as unknown (`None`).
+#[inline]
 fn mul_err(a: f64, b: f64) -> (f64, Option<f64>) {
     const BIG: f64 = 8.452_712_498_170_644e270; // 2^900
     const SMALL: f64 = 1.183_052_186_166_774_7e-271; // 2^−900
@@ -167,6 +173,22 @@ pub(crate) fn mul_down(a: f64, b: f64) -> f64 {
     match mul_err(a, b) {
         (p, Some(e)) if e >= 0.0 => p,
         (p, _) => next_down(p),
+    }
+}
+
+/// `a · b` toward `−∞` and toward `+∞`, from one TwoProduct: the same
+/// pair as `(mul_down(a, b), mul_up(a, b))`.
+#[inline]
+fn mul_down_up(a: f64, b: f64) -> (f64, f64) {
+    if a == 0.0 || b == 0.0 {
+        return (0.0, 0.0);
+    }
+    match mul_err(a, b) {
+        (p, Some(e)) => (
+            if e >= 0.0 { p } else { next_down(p) },
+            if e <= 0.0 { p } else { next_up(p) },
+        ),
+        (p, None) => (next_down(p), next_up(p)),
     }
 }
 
@@ -220,6 +242,7 @@ impl Interval {
 
     /// `[lo, hi]` from computed bounds: a NaN bound becomes infinite on its
     /// side, an overflowed bound the largest finite one.
+    #[inline]
     fn from_bounds(lo: f64, hi: f64) -> Self {
         let lo = if lo.is_nan() {
             f64::NEG_INFINITY
@@ -396,6 +419,7 @@ impl fmt::Display for Interval {
 
 impl Add for Interval {
     type Output = Self;
+    #[inline]
     fn add(self, o: Self) -> Self {
         Self::from_bounds(add_down(self.lo, o.lo), add_up(self.hi, o.hi))
     }
@@ -403,6 +427,7 @@ impl Add for Interval {
 
 impl Sub for Interval {
     type Output = Self;
+    #[inline]
     fn sub(self, o: Self) -> Self {
         Self::from_bounds(add_down(self.lo, -o.hi), add_up(self.hi, -o.lo))
     }
@@ -410,6 +435,7 @@ impl Sub for Interval {
 
 impl Neg for Interval {
     type Output = Self;
+    #[inline]
     fn neg(self) -> Self {
         Self {
             lo: -self.hi,
@@ -420,16 +446,40 @@ impl Neg for Interval {
 
 impl Mul for Interval {
     type Output = Self;
+    /// The product by the sign cases of the operands: only the corners that
+    /// can hold the smallest and the largest product are rounded (two
+    /// TwoProducts unless both operands straddle zero), each down or up as
+    /// [`mul_down`] and [`mul_up`] would.
+    #[inline]
     fn mul(self, o: Self) -> Self {
         let (a, b, c, d) = (self.lo, self.hi, o.lo, o.hi);
-        let lo = mul_down(a, c)
-            .min(mul_down(a, d))
-            .min(mul_down(b, c))
-            .min(mul_down(b, d));
-        let hi = mul_up(a, c)
-            .max(mul_up(a, d))
-            .max(mul_up(b, c))
-            .max(mul_up(b, d));
+        let down = |x, y| mul_down_up(x, y).0;
+        let up = |x, y| mul_down_up(x, y).1;
+        let (lo, hi) = if a >= 0.0 {
+            if c >= 0.0 {
+                (down(a, c), up(b, d))
+            } else if d <= 0.0 {
+                (down(b, c), up(a, d))
+            } else {
+                (down(b, c), up(b, d))
+            }
+        } else if b <= 0.0 {
+            if c >= 0.0 {
+                (down(a, d), up(b, c))
+            } else if d <= 0.0 {
+                (down(b, d), up(a, c))
+            } else {
+                (down(a, d), up(a, c))
+            }
+        } else if c >= 0.0 {
+            (down(a, d), up(b, d))
+        } else if d <= 0.0 {
+            (down(b, c), up(a, c))
+        } else {
+            let (ad, bc) = (mul_down_up(a, d), mul_down_up(b, c));
+            let (ac, bd) = (mul_down_up(a, c), mul_down_up(b, d));
+            (ad.0.min(bc.0), ac.1.max(bd.1))
+        };
         Self::from_bounds(lo, hi)
     }
 }
@@ -643,6 +693,66 @@ mod tests {
         assert_eq!(next_down(f64::INFINITY), f64::MAX);
         assert_eq!(next_up(f64::NEG_INFINITY), -f64::MAX);
         assert!(next_up(f64::NAN).is_nan());
+    }
+
+    /// The product by sign cases is the hull of the four corner products,
+    /// each rounded outward (the textbook definition), on every pair of a
+    /// grid of intervals with signs, zeros, infinities and inexact ends
+    /// (bit for bit where TwoProduct is exact at every corner, else within
+    /// it).
+    #[test]
+    fn products_by_sign_cases_equal_the_four_corner_hull() {
+        let ends = [
+            f64::NEG_INFINITY,
+            -1e300,
+            -3.7,
+            -0.1,
+            -0.0,
+            0.0,
+            1e-300,
+            0.3,
+            1.0 / 3.0,
+            2.0,
+            1e300,
+            f64::INFINITY,
+        ];
+        let mut boxes = Vec::new();
+        for &lo in &ends {
+            for &hi in &ends {
+                if let Some(x) = Interval::new(lo, hi) {
+                    boxes.push(x);
+                }
+            }
+        }
+        for &x in &boxes {
+            for &y in &boxes {
+                let corners = [(x.lo, y.lo), (x.lo, y.hi), (x.hi, y.lo), (x.hi, y.hi)];
+                let lo = corners
+                    .iter()
+                    .map(|&(a, b)| mul_down(a, b))
+                    .fold(f64::INFINITY, f64::min);
+                let hi = corners
+                    .iter()
+                    .map(|&(a, b)| mul_up(a, b))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let want = Interval::from_bounds(lo, hi);
+                let got = x * y;
+                // a corner out of TwoProduct's range is widened by an ulp
+                // even where it is not the extreme one: there the sign
+                // cases may be tighter, never wider
+                let ranged = corners
+                    .iter()
+                    .all(|&(a, b)| a == 0.0 || b == 0.0 || mul_err(a, b).1.is_some());
+                assert!(want.lo <= got.lo && got.hi <= want.hi, "{x:?} * {y:?}");
+                if ranged {
+                    assert_eq!(
+                        (got.lo.to_bits(), got.hi.to_bits()),
+                        (want.lo.to_bits(), want.hi.to_bits()),
+                        "{x:?} * {y:?}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -728,57 +728,46 @@ impl<const N: usize> CertifiedBounds<N> {
         if N > 0 {
             d_root[0] = Interval::new(0.0, 1.0).unwrap_or(Interval::ENTIRE);
         }
-        let cm = maximize(
-            Cell {
-                q: q_root,
-                w: d_root,
-            },
-            true,
-            boxes,
-            tol,
-            |c| {
-                if outside_ball(&c.w, 1.0) {
-                    return (f64::NEG_INFINITY, None, None);
-                }
-                let w = contract_to_ball(&c.w, 1.0);
-                let enclosure = mean_value(
-                    model.coriolis_enclosure(&vars(&c.q), &consts(&w)),
-                    model.coriolis_enclosure(&points(&c.q), &w),
-                    &c.q,
-                );
-                let d = unit_centre(&c.w, 1.0);
-                let at = norm_bound(&model.coriolis_enclosure(&points(&c.q), &points(&d)));
-                (norm_bound(&enclosure), Some(at), None)
-            },
-        );
+        let cm_root = Cell {
+            q: q_root,
+            w: d_root,
+        };
+        let cm = maximize(cm_root, true, boxes, tol, |c| {
+            if outside_ball(&c.w, 1.0) {
+                return (f64::NEG_INFINITY, None, None);
+            }
+            let w = contract_to_ball(&c.w, 1.0);
+            let slopes = model.coriolis_enclosure(&vars(&c.q), &consts(&w));
+            let hint = live_widest(c, &cm_root, &slopes);
+            let enclosure = mean_value(slopes, model.coriolis_enclosure(&points(&c.q), &w), &c.q);
+            let d = unit_centre(&c.w, 1.0);
+            let at = norm_bound(&model.coriolis_enclosure(&points(&c.q), &points(&d)));
+            (norm_bound(&enclosure), Some(at), hint)
+        });
         let coriolis = CertifiedConstant::from_outcome(cm, false);
 
         // C_F over the velocity cube ∩ ball
         let v_root = [Interval::new(-c_v, c_v).unwrap_or(Interval::ENTIRE); N];
-        let cf = maximize(
-            Cell {
-                q: q_root,
-                w: v_root,
-            },
-            true,
-            boxes,
-            tol,
-            |c| {
-                if outside_ball(&c.w, c_v) {
-                    return (f64::NEG_INFINITY, None, None);
-                }
-                let w = contract_to_ball(&c.w, c_v);
-                let enclosure = mean_value(
-                    model.forces_dv_enclosure(t_grad, &vars(&c.q), &consts(&w), &u_grad),
-                    model.forces_dv_enclosure(t, &points(&c.q), &w, u),
-                    &c.q,
-                );
-                let v = unit_centre(&c.w, c_v);
-                let at =
-                    norm_bound(&model.forces_dv_enclosure(t, &points(&c.q), &points(&v), &u_mid));
-                (norm_bound(&enclosure), Some(at), None)
-            },
-        );
+        let cf_root = Cell {
+            q: q_root,
+            w: v_root,
+        };
+        let cf = maximize(cf_root, true, boxes, tol, |c| {
+            if outside_ball(&c.w, c_v) {
+                return (f64::NEG_INFINITY, None, None);
+            }
+            let w = contract_to_ball(&c.w, c_v);
+            let slopes = model.forces_dv_enclosure(t_grad, &vars(&c.q), &consts(&w), &u_grad);
+            let hint = live_widest(c, &cf_root, &slopes);
+            let enclosure = mean_value(
+                slopes,
+                model.forces_dv_enclosure(t, &points(&c.q), &w, u),
+                &c.q,
+            );
+            let v = unit_centre(&c.w, c_v);
+            let at = norm_bound(&model.forces_dv_enclosure(t, &points(&c.q), &points(&v), &u_mid));
+            (norm_bound(&enclosure), Some(at), hint)
+        });
         let force_lipschitz = CertifiedConstant::from_outcome(cf, false);
         for (which, c) in [
             ("M", &mass_max),
@@ -1009,6 +998,36 @@ fn radical_inverse(mut index: u64, base: u64) -> f64 {
         index /= base;
     }
     x
+}
+
+/// Where to bisect a cell of the `C_M` or `C_F` search: the coordinate
+/// widest relative to the root box, among the directions or velocities and
+/// the configurations the matrix depends on over the cell (a `q_m` whose
+/// slope enclosure is exactly zero in every entry, as the first angle of a
+/// chain with relative angles, is never split: that would only double the
+/// cells). `None` (the search's own rule) when nothing is left.
+#[cfg(feature = "std")]
+fn live_widest<const N: usize>(
+    cell: &Cell<N>,
+    root: &Cell<N>,
+    slopes: &[[Gradient<N>; N]; N],
+) -> Option<usize> {
+    let live = |m: usize| slopes.iter().flatten().any(|x| x.g[m].mag() != 0.0);
+    let mut best: Option<(f64, usize)> = None;
+    for k in 0..2 * N {
+        let (x, r) = if k < N {
+            (cell.q[k], root.q[k])
+        } else {
+            (cell.w[k - N], root.w[k - N])
+        };
+        if r.width() > 0.0 && (k >= N || live(k)) {
+            let rel = x.width() / r.width();
+            if best.is_none_or(|(b, _)| rel > b) {
+                best = Some((rel, k));
+            }
+        }
+    }
+    best.map(|(_, k)| k)
 }
 
 #[cfg(test)]

@@ -39,6 +39,9 @@
 //! used elsewhere; on the shipped models it saves far more than it costs.)
 
 mod simplify;
+mod trig;
+
+pub use trig::TrigForm;
 
 use std::collections::{HashMap, HashSet};
 use std::fmt;

@@ -390,3 +390,86 @@ fn to_infix_parenthesizes_by_precedence() {
     let e = g.exp(a);
     assert_eq!(show(&g, e), "exp(atan2(x, y))");
 }
+
+mod trig {
+    use crate::graph::TrigForm;
+    use crate::{Graph, VarId};
+
+    /// Values of `e` and of its normal form agree at scattered points.
+    fn agrees(g: &mut Graph, e: crate::Id, n: crate::Id, vars: usize) {
+        for k in 0..20 {
+            let x: Vec<f64> = (0..vars)
+                .map(|i| ((k * 7 + i * 13) as f64 * 0.731).sin() * 3.0)
+                .collect();
+            let (a, b) = (g.eval(&[e], &x)[0], g.eval(&[n], &x)[0]);
+            assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn pythagoras_and_angle_differences_cancel() {
+        let mut g = Graph::new();
+        let (a, b, m) = (g.var(VarId(0)), g.var(VarId(1)), g.var(VarId(2)));
+        // m (l1 cos a + l2 cos(a+b))² + m (l1 sin a + l2 sin(a+b))²
+        // = m (l1² + l2² + 2 l1 l2 cos b) with l1 = 2, l2 = 3
+        let ab = g.add(a, b);
+        let (ca, sa, cab, sab) = (g.cos(a), g.sin(a), g.cos(ab), g.sin(ab));
+        let (two, three) = (g.constant(2.0), g.constant(3.0));
+        let x = g.mul(two, ca);
+        let x2 = g.mul(three, cab);
+        let x = g.add(x, x2);
+        let y = g.mul(two, sa);
+        let y2 = g.mul(three, sab);
+        let y = g.add(y, y2);
+        let (xx, yy) = (g.powi(x, 2), g.powi(y, 2));
+        let s = g.add(xx, yy);
+        let e = g.mul(m, s);
+        let n = TrigForm::new().normal(&mut g, e);
+        assert!(
+            !g.depends_on(n, VarId(0)),
+            "{}",
+            g.to_infix(n, &|v| v.to_string())
+        );
+        agrees(&mut g, e, n, 3);
+        let names = |v: VarId| ["a", "b", "m"][v.index()].to_string();
+        assert_eq!(g.to_infix(n, &names), "(13 + 12 * cos(b)) * m");
+    }
+
+    #[test]
+    fn products_become_waves_of_sums_and_differences() {
+        let mut g = Graph::new();
+        let (a, b) = (g.var(VarId(0)), g.var(VarId(1)));
+        let (sa, cb) = (g.sin(a), g.cos(b));
+        let e = g.mul(sa, cb);
+        let c = g.sin(a);
+        let e = g.mul(e, c); // sin²a cos b
+        let n = TrigForm::new().normal(&mut g, e);
+        agrees(&mut g, e, n, 2);
+        // a constant offset or a non-integer multiple keeps its argument whole
+        let one = g.constant(1.0);
+        let half = g.constant(0.5);
+        for arg in [g.add(a, one), g.mul(half, a)] {
+            let s = g.sin(arg);
+            let s2 = g.powi(s, 2);
+            let cc = g.cos(arg);
+            let c2 = g.powi(cc, 2);
+            let e = g.add(s2, c2);
+            let n = TrigForm::new().normal(&mut g, e);
+            assert_eq!(n, e);
+        }
+    }
+
+    #[test]
+    fn a_form_too_large_is_kept_as_it_was() {
+        let mut g = Graph::new();
+        let mut e = g.constant(1.0);
+        for i in 0..40 {
+            let x = g.var(VarId(i));
+            let c = g.cos(x);
+            let s = g.add(c, x);
+            e = g.mul(e, s);
+        }
+        let n = TrigForm::new().normal(&mut g, e);
+        assert_eq!(n, e);
+    }
+}

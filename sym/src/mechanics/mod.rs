@@ -16,6 +16,12 @@
 //! With the Christoffel symbols `Γ`, `Ṁ − 2C` is skew-symmetric, which the
 //! observers' passivity argument needs.
 //!
+//! Each `M_ij` and `V` are put in the trigonometric normal form of
+//! [`TrigForm`] before they are differentiated, so that `sin² + cos²` of an
+//! angle cancels and products of `sin`/`cos` become waves of angle sums and
+//! differences: a chain's `M` depends on differences of its absolute angles
+//! only, or not on its first relative angle.
+//!
 //! # Work sharing
 //!
 //! `T` is differentiated once per velocity (`p`), and `M` is differentiated
@@ -49,7 +55,7 @@ mod lincomb;
 
 pub use layout::{Layout, Quantity, Slot};
 
-use crate::graph::Graph;
+use crate::graph::{Graph, TrigForm};
 use crate::node::{Id, VarId};
 use lincomb::{lincomb, sum};
 
@@ -247,7 +253,8 @@ impl Mechanics {
         // dm[i][j][k] = ∂M_ij/∂q_k, shared by C and ∂(M v)/∂q.
         let dm = mass_derivatives(g, sys, &mass);
         let coriolis = coriolis(g, sys, &dm);
-        let gravity = g.gradient(sys.potential, sys.q);
+        let potential = TrigForm::new().normal(g, sys.potential);
+        let gravity = g.gradient(potential, sys.q);
         let forces = total_forces(g, sys, &coriolis, &gravity);
         let jacobian = g.jacobian(sys.gaps, sys.q);
         let force_dq = g.jacobian(&forces, sys.q);
@@ -347,6 +354,7 @@ fn mass_matrix(
     let n = sys.q.len();
     let zero = g.constant(0.0);
     let momentum = g.gradient(sys.kinetic, sys.v);
+    let mut trig = TrigForm::new();
     let mut mass = vec![vec![zero; n]; n];
     for (i, &p) in momentum.iter().enumerate() {
         for j in i..n {
@@ -358,6 +366,7 @@ fn mass_matrix(
                     velocity: k,
                 });
             }
+            let m = trig.normal(g, m);
             mass[i][j] = m;
             mass[j][i] = m;
         }

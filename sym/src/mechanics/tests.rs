@@ -108,7 +108,7 @@ fn double_pendulum_closed_forms() {
     let names = |v| b.name(v);
     assert_eq!(
         b.g.to_infix(mech.coriolis[0][1], &names),
-        "m2 * l1 * l2 * sin(th1 - th2) * w2"
+        "l1 * l2 * m2 * sin(th1 - th2) * w2"
     );
     assert_eq!(b.g.to_infix(mech.mass[0][0], &names), "(m1 + m2) * l1^2");
 }
