@@ -183,8 +183,11 @@ fn lets<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body, lets: &[Let]) {
 /// optimisation of one function grow faster than linearly in its size).
 /// With folded expressions bounded by
 /// [`MAX_FOLD_SIZE`](super::body::MAX_FOLD_SIZE), a part weighs at most
-/// `PART + MAX_FOLD_SIZE` plus its constants.
-pub(crate) const PART: usize = 2048;
+/// `PART + 2 MAX_FOLD_SIZE` plus its constants. The cut costs time at run
+/// time (the parts do not inline into each other), so it is kept for large
+/// bodies: the 10-link chain (weight 2 663) is one function, the 11-link
+/// one (3 309, 550 bindings) two, as with the former cut at 512 bindings.
+pub(crate) const PART: usize = 3000;
 
 /// One part of a long body: its bindings, the constants and the locals it
 /// reads from before it, and the locals it defines that are read after it.
