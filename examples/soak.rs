@@ -1,8 +1,8 @@
 //! Soak runs of the plant stepper (issue 9): every shipped model, without
 //! damping or inputs, with restitution 1 and with its own restitution
-//! (< 1), stepped at τ = 1e-3 by the energy-consistent midpoint step
-//! (`ApproachVelocity::Midpoint`) and, for comparison, by the default law
-//! (`ApproachVelocity::Slower`, Siconos' θ-method). For each run it prints
+//! (< 1), stepped at τ = 1e-3 by the default, energy-consistent midpoint
+//! step (`ApproachVelocity::Midpoint`) and, for comparison, by Siconos'
+//! θ-method with the law `ApproachVelocity::Slower`. For each run it prints
 //! the energy `½ vᵀM(q)v + V(q)` (start, min, max, final, and the drift per
 //! 10⁶ steps fitted by least squares), the deepest penetration, the number
 //! of steps with an impulse and the wall-clock time per step (energy

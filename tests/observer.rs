@@ -14,7 +14,7 @@ use moreau::{
 };
 mod common;
 
-use common::runs::{Figures, Reference, errors, figures, measure, reference};
+use common::runs::{Figures, Reference, errors, figures, measure, reference, score};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
@@ -574,8 +574,25 @@ fn decays_at_the_guaranteed_rate<M>(
 /// each impact leaves roughly `δ` times the normal speed in `ṽ`, which the
 /// injection then removes at `l_d`. Over the bouncing stretch of Example 1
 /// (`t ∈ [1.5, 4.45)` s, after the initial transient and before the
-/// accumulation ends) the mean and the maximum of `|v − v̂|` grow with `δ`:
-/// asserted strictly increasing, and near zero for `δ = 0`.
+/// accumulation ends) the mean of `|v − v̂|`, and its maximum over the
+/// samples that do not bracket a plant impact, grow with `δ`: asserted
+/// strictly increasing. The maximum over all samples is printed, not
+/// asserted: once `|ṽ| τ_s` exceeds the distance the plant still has to go
+/// to an impact just after a sample, the observer applies Newton's law one
+/// sample early, and that sample carries the whole jump `(1 + ê) u`, which
+/// *shrinks* as `ê = e − δ` does (measured: 5.33 at `δ = 0.1`, 5.12 at
+/// `δ = 0.2`, both the sample 40 µs before the impact at 1.778 s, ratio
+/// 1.04 ≈ 1.8 / 1.7).
+///
+/// With `δ = 0` the observer applies every plant impact itself: at each
+/// sample of the stretch `|v − v̂|` stays below the velocity jump
+/// `(1 + e) u` of the latest plant impact (approach speed `u`), which an
+/// impact missed, or applied twice, would leave whole. The bound is not
+/// empty where it matters: at the end of the stretch the impacts come
+/// every 0.9 ms, at `u ≈ 0.05 m/s`, faster than the 1 kHz samples, and the
+/// error there (up to a third of the jump, 3.1e-2, the largest of the
+/// stretch; below 5e-3 before the accumulation) depends on where the
+/// impacts fall between the samples, so on the plant's Newton's law.
 #[test]
 fn restitution_mismatch_grows_the_error() {
     let model = Parabola::<f64>::new();
@@ -597,21 +614,51 @@ fn restitution_mismatch_grows_the_error() {
             .with_restitution(e.add_scalar(-delta))
             .unwrap();
         let estimates = observe(&mut observer, &model, &data, &measured, &u);
-        let errors = window(&data, &errors(&data, &estimates), 1.5, 4.45);
+        let all = errors(&data, &estimates);
+        if delta == 0.0 {
+            below_the_latest_jump(&data, &all, e.as_slice(), (1.5, 4.45));
+        }
+        let errors = window(&data, &all, 1.5, 4.45);
         let mean = errors.iter().sum::<f64>() / errors.len() as f64;
         let f = figures(&errors);
+        let clean = score(&data, &estimates, (1.5, 4.45)).clean;
         eprintln!(
-            "ê = e − {delta}: |v − v̂| over [1.5, 4.45) s: mean {mean:.2e}, median {:.2e}, p90 {:.2e}, max {:.2e}",
-            f.median, f.p90, f.max
+            "ê = e − {delta}: |v − v̂| over [1.5, 4.45) s: mean {mean:.2e}, median {:.2e}, p90 {:.2e}, max {:.2e}, max off the impacts {:.2e}",
+            f.median, f.p90, f.max, clean.max
         );
-        curve.push((delta, mean, f.max));
+        curve.push((delta, mean, clean.max));
     }
     for w in curve.windows(2) {
         assert!(w[1].1 > w[0].1 && w[1].2 > w[0].2, "{curve:?}");
     }
-    // with the plant's own e, the stretch is at the level of Example 1's
-    // figures (max 2.1e-2 over [2, 10] s, during the accumulation)
-    assert!(curve[0].2 < 2.1e-2, "{curve:?}");
+}
+
+/// Asserts `|v − v̂| < (1 + e_i) u` at every sample of `[from, to)`, `u` the
+/// approach speed of the latest plant impact (on constraint `i`) at or
+/// before the sample.
+fn below_the_latest_jump<const N: usize>(
+    data: &Reference<N>,
+    errors: &[f64],
+    e: &[f64],
+    (from, to): (f64, f64),
+) {
+    let mut worst = (0.0, 0.0);
+    for (s, &err) in data.samples.iter().zip(errors) {
+        if s.t < from - 1e-9 || s.t >= to - 1e-9 {
+            continue;
+        }
+        let latest = data.impacts.iter().rev().find(|i| i.0 <= s.t + 1e-9);
+        let &(_, i, u) = latest.expect("a plant impact before the stretch");
+        let ratio = err / ((1.0 + e[i]) * u);
+        if ratio > worst.0 {
+            worst = (ratio, s.t);
+        }
+    }
+    eprintln!(
+        "ê = e: |v − v̂| is at most {:.2} of the latest plant impact's jump (at t = {:.3} s)",
+        worst.0, worst.1
+    );
+    assert!(worst.0 < 1.0, "{worst:?}");
 }
 
 /// Gaussian noise of standard deviation `σ` on each measured coordinate

@@ -21,6 +21,13 @@ use crate::scope::Var;
 /// parts are bound to names.
 const MAX_FOLD_DEPTH: usize = 24;
 
+/// The most operations one folded expression may hold before it is bound
+/// to a name: a sum of thousands of single-use terms would otherwise fold
+/// into one `let` (its balanced tree never reaches [`MAX_FOLD_DEPTH`]),
+/// which no cut of the body into parts can split, and whose type checking
+/// and borrow checking grow faster than linearly in rustc.
+pub(crate) const MAX_FOLD_SIZE: usize = 64;
+
 /// An expression of the generated code.
 #[derive(Clone, Debug)]
 pub(crate) enum Code {
@@ -61,6 +68,15 @@ impl Code {
             Code::Binary(_, a, b) | Code::Powf(a, b) | Code::Atan2(a, b) => {
                 1 + a.depth().max(b.depth())
             }
+        }
+    }
+
+    /// Number of operations and names in the expression (a name is 1).
+    pub fn size(&self) -> usize {
+        match self {
+            Code::Local(_) => 1,
+            Code::Neg(a) | Code::Powi(a, _) | Code::Func(_, a) | Code::SinCos(a) => 1 + a.size(),
+            Code::Binary(_, a, b) | Code::Powf(a, b) | Code::Atan2(a, b) => 1 + a.size() + b.size(),
         }
     }
 
@@ -179,8 +195,15 @@ pub(crate) fn build(
             // Fold a temporary into its only consumer, unless the folded
             // expression would nest deeper than MAX_FOLD_DEPTH (a long sum
             // `a + b + c + ...` is a left-deep tree; rustc's parser and
-            // lints recurse over it).
-            None if uses[k] == 1 && code.depth() < MAX_FOLD_DEPTH => code,
+            // lints recurse over it) or hold more than MAX_FOLD_SIZE
+            // operations (its operands are folded only below that size, so
+            // measuring it costs at most 2 MAX_FOLD_SIZE).
+            None if uses[k] == 1
+                && code.depth() < MAX_FOLD_DEPTH
+                && code.size() < MAX_FOLD_SIZE =>
+            {
+                code
+            }
             None => {
                 let local = role(&code).unwrap_or_else(|| {
                     b.temps += 1;

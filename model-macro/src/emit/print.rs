@@ -117,7 +117,8 @@ fn infix(op: Op) -> char {
 }
 
 /// Prints the statements of `body`: unpacked variables, constants, then
-/// every binding in order.
+/// every binding in order; a body heavier than [`PART`] in parts, each
+/// binding the constants it reads itself.
 pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) {
     for &var in &body.unpack {
         s.binding(
@@ -133,15 +134,16 @@ pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) 
             None,
         );
     }
-    for (i, &value) in body.constants.iter().enumerate() {
-        let name = body.names.get(Local::Const(i));
-        s.binding(&mut |s| s.internal(name), true, &mut |s| s.cst(value), None);
-    }
-    if body.lets.len() <= PART {
+    let weight: usize =
+        body.constants.len() + body.lets.iter().map(|l| l.code.size()).sum::<usize>();
+    if weight <= PART {
+        constants(s, body, 0..body.constants.len());
         lets(s, model, body, &body.lets);
         return;
     }
-    for part in parts(body) {
+    let (parts, top_constants) = parts(body);
+    constants(s, body, top_constants);
+    for part in parts {
         let name = |local: &Local| match local {
             Local::Var(var) => (model.var_name(*var), true),
             other => (body.names.get(*other), false),
@@ -149,8 +151,18 @@ pub(crate) fn statements<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body) 
         let live_in: Vec<(&str, bool)> = part.live_in.iter().map(name).collect();
         let live_out: Vec<(&str, bool)> = part.live_out.iter().map(name).collect();
         s.part(&live_in, &live_out, &mut |s| {
+            constants(s, body, part.constants.iter().copied());
             lets(s, model, body, &body.lets[part.range.clone()]);
         });
+    }
+}
+
+/// `let k: T = cst(x);` for each of the constants `which`.
+fn constants<S: Sink>(s: &mut S, body: &Body, which: impl IntoIterator<Item = usize>) {
+    for i in which {
+        let name = body.names.get(Local::Const(i));
+        let value = body.constants[i];
+        s.binding(&mut |s| s.internal(name), true, &mut |s| s.cst(value), None);
     }
 }
 
@@ -174,40 +186,70 @@ fn lets<S: Sink>(s: &mut S, model: &Resolved<'_>, body: &Body, lets: &[Let]) {
     }
 }
 
-/// The most bindings one function of the generated code holds: a longer
-/// body (a potential of thousands of terms) is cut into parts of this size,
-/// each a nested `#[inline(never)]` function taking the values it reads and
-/// returning those read after it, so that the compiler never sees one huge
-/// function (whose optimisation grows faster than linearly in its size).
-pub(crate) const PART: usize = 512;
+/// The heaviest one function of the generated code gets, in operations
+/// and names of its bindings ([`Code::size`](super::body::Code::size)) plus
+/// its constants: a heavier body (a potential of thousands of terms) is cut
+/// into parts of about this weight, each a nested `#[inline(never)]`
+/// function that binds the constants it reads, takes the other values it
+/// reads and returns those read after it, so that the compiler never sees
+/// one huge function (rustc's type checking, borrow checking and MIR
+/// optimisation of one function grow faster than linearly in its size).
+/// With folded expressions bounded by
+/// [`MAX_FOLD_SIZE`](super::body::MAX_FOLD_SIZE), a part weighs at most
+/// `PART + 2 MAX_FOLD_SIZE` plus its constants. The cut costs time at run
+/// time (the parts do not inline into each other), so it is kept for large
+/// bodies: the 10-link chain (weight 2 663) is one function, the 11-link
+/// one (3 309, 550 bindings) two, as with the former cut at 512 bindings.
+pub(crate) const PART: usize = 3000;
 
-/// One part of a long body: its bindings, the locals it reads from before
-/// it, and the locals it defines that are read after it.
-struct Part {
-    range: std::ops::Range<usize>,
-    live_in: Vec<Local>,
-    live_out: Vec<Local>,
+/// One part of a long body: its bindings, the constants and the locals it
+/// reads from before it, and the locals it defines that are read after it.
+pub(super) struct Part {
+    pub range: std::ops::Range<usize>,
+    pub constants: Vec<usize>,
+    pub live_in: Vec<Local>,
+    pub live_out: Vec<Local>,
 }
 
-/// Cuts `body.lets` into parts of at most [`PART`] bindings.
-fn parts(body: &Body) -> Vec<Part> {
+/// Cuts `body.lets` into consecutive parts of weight about [`PART`]; also
+/// returns the constants the outputs read (bound before the parts).
+pub(super) fn parts(body: &Body) -> (Vec<Part>, Vec<usize>) {
     use std::collections::{HashMap, HashSet};
+    // part of each binding: a new part starts once the weight reaches PART
+    let mut part_of = Vec::with_capacity(body.lets.len());
+    let (mut part, mut weight) = (0, 0);
+    for l in &body.lets {
+        if weight >= PART {
+            (part, weight) = (part + 1, 0);
+        }
+        weight += l.code.size();
+        part_of.push(part);
+    }
+    let count = part + 1;
     let defined: HashMap<Local, usize> = body
         .lets
         .iter()
-        .enumerate()
-        .flat_map(|(i, l)| {
+        .zip(&part_of)
+        .flat_map(|(l, &p)| {
             core::iter::once(l.local)
                 .chain(l.pair)
-                .map(move |local| (local, i / PART))
+                .map(move |local| (local, p))
         })
         .collect();
-    let count = body.lets.len().div_ceil(PART);
     let mut live_in: Vec<Vec<Local>> = vec![Vec::new(); count];
     let mut live_out: Vec<Vec<Local>> = vec![Vec::new(); count];
-    let mut seen_in: Vec<HashSet<Local>> = vec![HashSet::new(); count];
+    let mut consts: Vec<Vec<usize>> = vec![Vec::new(); count + 1];
+    let mut seen_in: Vec<HashSet<Local>> = vec![HashSet::new(); count + 1];
     let mut seen_out: Vec<HashSet<Local>> = vec![HashSet::new(); count];
     let mut read = |reader: Option<usize>, local: Local| {
+        if let Local::Const(i) = local {
+            // constants are bound where they are read: the outputs' at the top
+            let at = reader.unwrap_or(count);
+            if seen_in[at].insert(local) {
+                consts[at].push(i);
+            }
+            return;
+        }
         let home = defined.get(&local).copied();
         if let Some(p) = reader
             && home != Some(p)
@@ -222,20 +264,28 @@ fn parts(body: &Body) -> Vec<Part> {
             live_out[h].push(local);
         }
     };
-    for (i, l) in body.lets.iter().enumerate() {
-        l.code
-            .visit_locals(&mut |local| read(Some(i / PART), local));
+    for (l, &p) in body.lets.iter().zip(&part_of) {
+        l.code.visit_locals(&mut |local| read(Some(p), local));
     }
     for out in &body.outputs {
         out.visit_locals(&mut |local| read(None, local));
     }
-    (0..count)
-        .map(|p| Part {
-            range: p * PART..((p + 1) * PART).min(body.lets.len()),
-            live_in: std::mem::take(&mut live_in[p]),
-            live_out: std::mem::take(&mut live_out[p]),
+    let top = std::mem::take(&mut consts[count]);
+    let mut start = 0;
+    let parts = (0..count)
+        .map(|p| {
+            let end = start + part_of[start..].iter().take_while(|&&q| q == p).count();
+            let range = start..end;
+            start = end;
+            Part {
+                range,
+                constants: std::mem::take(&mut consts[p]),
+                live_in: std::mem::take(&mut live_in[p]),
+                live_out: std::mem::take(&mut live_out[p]),
+            }
         })
-        .collect()
+        .collect();
+    (parts, top)
 }
 
 fn index<S: Sink>(s: &mut S, arg: &str, i: usize) {

@@ -10,13 +10,22 @@ fn shipped<R>(stem: &str, f: impl FnOnce(&Resolved<'_>, &Lowered) -> R) -> R {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
     let path = dir.join(format!("{stem}.yaml"));
     let text = std::fs::read_to_string(&path).unwrap();
+    compiled(&path, text, f)
+}
+
+/// Compiles the YAML model `text` (read from `path`) and runs `f` on it.
+fn compiled<R>(
+    path: &std::path::Path,
+    text: String,
+    f: impl FnOnce(&Resolved<'_>, &Lowered) -> R,
+) -> R {
     let source = YamlSource {
-        display: format!("models/{stem}.yaml"),
+        display: path.display().to_string(),
         text: text.clone(),
     };
     let root = source.parse().unwrap();
     let cx = Ctxt::with_locator(source);
-    let spec = yaml::build(&cx, &root, Span::call_site(), &path, text).unwrap();
+    let spec = yaml::build(&cx, &root, Span::call_site(), path, text).unwrap();
     let compiled = expand::compile(&cx, &spec);
     cx.check().unwrap();
     let (model, lowered) = compiled.unwrap();
@@ -136,4 +145,55 @@ fn op_counts_at_most_casadis() {
         }
     }
     assert!(over.is_empty(), "more operations than CasADi: {over:?}");
+}
+
+/// A potential of `N` terms `c sin(x + i)` (issue 9's compile-cost model):
+/// no folded expression outgrows [`body::MAX_FOLD_SIZE`] (its operands are
+/// at most that size), the fused body is cut into parts of weight at most
+/// [`print::PART`] plus one binding, each part binds only constants its
+/// own bindings read, and the parts are as many as the weight asks for:
+/// what rustc receives per function is bounded, whatever `N`.
+#[test]
+fn long_bodies_are_cut_into_bounded_parts() {
+    use body::MAX_FOLD_SIZE;
+    use print::PART;
+    let n = 3000;
+    let terms: Vec<String> = (0..n)
+        .map(|i| format!("{}.5 * sin(x + {i})", i % 7 + 1))
+        .collect();
+    let text = format!(
+        "name: Big\ncoordinates:\n  - x: vx\nkinetic: 0.5 * vx^2\npotential: {}\n\
+         constraints:\n  - name: floor\n    h: x + 1\nrestitution: 0.5\n",
+        terms.join(" + ")
+    );
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("big.yaml");
+    compiled(&path, text, |model, lowered| {
+        let (_, body) = Emitter::new(model, lowered).body(&Quantity::EVAL);
+        let largest = body.lets.iter().map(|l| l.code.size()).max().unwrap();
+        assert!(largest <= 2 * MAX_FOLD_SIZE, "{largest}");
+        let weight: usize = body.lets.iter().map(|l| l.code.size()).sum();
+        let (parts, top) = print::parts(&body);
+        assert!(
+            parts.len() >= weight / (PART + 2 * MAX_FOLD_SIZE),
+            "{}",
+            parts.len()
+        );
+        assert!(parts.len() <= weight / PART + 1, "{}", parts.len());
+        for part in &parts {
+            let lets = &body.lets[part.range.clone()];
+            let w: usize = lets.iter().map(|l| l.code.size()).sum();
+            assert!(w <= PART + 2 * MAX_FOLD_SIZE, "{w}");
+            for &c in &part.constants {
+                let mut read = false;
+                for l in lets {
+                    l.code
+                        .visit_locals(&mut |local| read |= local == names::Local::Const(c));
+                }
+                assert!(read, "constant {c} bound in a part that does not read it");
+            }
+        }
+        assert!(top.len() <= body.outputs.len(), "{}", top.len());
+        let ranges: usize = parts.iter().map(|p| p.range.len()).sum();
+        assert_eq!(ranges, body.lets.len());
+    });
 }

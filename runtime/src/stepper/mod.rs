@@ -25,8 +25,10 @@
 //!      constraint:
 //!      `0 ≤ λ ⊥ J(q̃) v_{k+1} + e u ≥ 0` with
 //!      `v_{k+1} = v_free + W⁻¹ J(q̃)ᵀ λ`, where the approach velocity `u`
-//!      is `J(q_k) v_k` in Siconos and, by default, the slower of
-//!      `J(q_k) v_k` and `J(q̃) v_k` (see [`ApproachVelocity`] for why);
+//!      is `J(q_k) v_k` in Siconos ([`ApproachVelocity::Start`]), or the
+//!      slower of `J(q_k) v_k` and `J(q̃) v_k` ([`ApproachVelocity::Slower`];
+//!      see [`ApproachVelocity`] for why; the default, the midpoint step, is
+//!      below);
 //!    - position `q_{k+1} = q_k + τ (θ v_{k+1} + (1 − θ) v_k)`;
 //!    - stop when `‖M(q_{k+1})(v_{k+1} − v_k) + τ[θ F_{k+1} + (1 − θ) F_k] − Jᵀλ‖₂`
 //!      is at most the tolerance, or after the last allowed iteration;
@@ -42,7 +44,7 @@
 //! step is a pure function of them, and a step that fails leaves the state
 //! as it was.
 //!
-//! # Energy: the midpoint step ([`ApproachVelocity::Midpoint`])
+//! # Energy: the midpoint step ([`ApproachVelocity::Midpoint`], the default)
 //!
 //! The steps above (Siconos' scheme, under any of the laws `Start`,
 //! `Iterate`, `Slower`) gain energy when `M` depends on `q`. Measured on
@@ -110,8 +112,10 @@
 //!
 //! Over `10⁷` steps (`10⁴` s, 25,285 impact steps) the double pendulum's
 //! energy stays between `E₀ − 3.5e-4 J` and `E₀ + 1.8e-4 J`, with no
-//! trend; `examples/soak.rs` measures every shipped model. The first three laws stay as they were,
-//! `Start` step for step with Siconos.
+//! trend; `examples/soak.rs` measures every shipped model. It is the
+//! default of [`StepParams::new`], since a run with the defaults must not
+//! gain energy; the first three laws stay as they were, `Start`
+//! ([`StepParams::siconos`]) step for step with Siconos.
 
 mod error;
 mod params;
