@@ -125,6 +125,7 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
     /// is unchanged, else factored now. `None` (the caller factors `M` where
     /// it evaluates it, and reports a failure there) for any other model or
     /// when `M` does not factor.
+    #[inline]
     fn mass<M, const K: usize>(&mut self, model: &M, q: &SVector<T, N>) -> Option<Cholesky<T, N>>
     where
         M: Model<N, K, Scalar = T>,
@@ -632,8 +633,8 @@ where
         touched: IndexSet<K>,
     ) -> Result<Classes<K>, T> {
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
-        let mut c = Classes::default();
         let band = self.params.contact_band();
+        let mut c = Classes::default();
         let noise_speed = self.noise_speed();
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
         let four: T = nalgebra::convert(4.0);
@@ -689,6 +690,29 @@ where
             }
         }
         Ok(c)
+    }
+
+    /// [`classify`](Self::classify), with its common case first and
+    /// inlined: every constraint clearly open and none touched, so all
+    /// free (the classes built whole where they are read: set one entry at
+    /// a time in `classify`, they cost a store-forwarding stall there).
+    #[inline(always)]
+    fn classes(
+        &self,
+        at: &Point<'_, T, N>,
+        (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
+        resolved: IndexSet<K>,
+        touched: IndexSet<K>,
+    ) -> Result<Classes<K>, T> {
+        let band = self.params.contact_band();
+        if touched.is_empty() && (0..K).all(|i| clearly_open(h[i], jac.row(i).norm_squared(), band))
+        {
+            return Ok(Classes {
+                free: IndexSet::full(K),
+                ..Classes::default()
+            });
+        }
+        self.classify(at, (h, jac), resolved, touched)
     }
 
     /// `h_i` along the segment at `σ`.

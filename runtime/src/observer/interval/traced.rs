@@ -101,7 +101,7 @@ where
                 w: &w,
                 free: &free,
             };
-            let c = self.classify(&point, (&h, &jac), resolved, touched)?;
+            let c = self.classes(&point, (&h, &jac), resolved, touched)?;
             // IMPACT now, on the closed constraints met approaching
             if !c.approaching.is_empty() && !last_round {
                 let elastic = if report.impacts < max_impacts {
