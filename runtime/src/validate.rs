@@ -25,9 +25,10 @@ pub(crate) fn finite_model<T: RealField + Copy, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     which: &'static str,
 ) -> Result<(), DataError<T>> {
-    // `x − x` is `0` for a finite `x` and NaN otherwise: one sum, no
+    // `0 · x` is `±0` for a finite `x` and NaN otherwise: one sum, no
     // branch per entry
-    if m.iter().fold(T::zero(), |acc, x| acc + (*x - *x)) == T::zero() {
+    let zero = T::zero();
+    if m.iter().fold(zero, |acc, x| acc + *x * zero) == zero {
         Ok(())
     } else {
         Err(DataError::NonFiniteModel { which })
