@@ -25,10 +25,7 @@ pub(crate) fn finite_model<T: RealField + Copy, const R: usize, const C: usize>(
     m: &SMatrix<T, R, C>,
     which: &'static str,
 ) -> Result<(), DataError<T>> {
-    // `0 · x` is `±0` for a finite `x` and NaN otherwise: one sum, no
-    // branch per entry
-    let zero = T::zero();
-    if m.iter().fold(zero, |acc, x| acc + *x * zero) == zero {
+    if m.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
         Err(DataError::NonFiniteModel { which })
@@ -36,6 +33,7 @@ pub(crate) fn finite_model<T: RealField + Copy, const R: usize, const C: usize>(
 }
 
 /// Factors `M`, rejecting a non-finite or indefinite one.
+#[inline]
 pub(crate) fn factor_mass<T: RealField + Copy, const N: usize>(
     mass: &SMatrix<T, N, N>,
 ) -> Result<Cholesky<T, N>, DataError<T>> {
