@@ -33,6 +33,7 @@ pub(crate) fn finite_model<T: RealField + Copy, const R: usize, const C: usize>(
 }
 
 /// Factors `M`, rejecting a non-finite or indefinite one.
+#[inline]
 pub(crate) fn factor_mass<T: RealField + Copy, const N: usize>(
     mass: &SMatrix<T, N, N>,
 ) -> Result<Cholesky<T, N>, DataError<T>> {

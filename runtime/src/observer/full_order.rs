@@ -6,7 +6,7 @@ use crate::lcp::Lcp;
 use crate::linalg::{Cholesky, SymmetricEigen};
 use crate::model::Model;
 
-use super::interval::{Cache, Interval, Memory, saturate};
+use super::interval::{Cache, Interval, Memory, saturate, saturate_for};
 use super::reduced_order::{restart_velocity, section_vii_impact};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
@@ -309,7 +309,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
         let (mass, forces) = interval.model.dynamics(
             interval.t0 + tau,
             q1,
-            &saturate(&v_pre, self.params.velocity_bound),
+            &saturate_for::<M, T, N, K>(&v_pre, self.params.velocity_bound),
             interval.u,
         );
         report.evaluations += 1;
@@ -444,7 +444,7 @@ where
             lcp: &self.lcp,
             t: self.t,
             q: self.q,
-            restitution: self.restitution,
+            restitution: self.restitution.as_ref(),
             report: &self.report,
         };
         let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;

@@ -22,12 +22,38 @@ pub(crate) use traced::{Flight, Jump, Tracer};
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
 /// the ball `|v| ≤ C_v`, 1-Lipschitz, so `F̄(t, q, v) = F(t, q, sat(v))` is
 /// the Lipschitz extension of Assumption 1.
+///
+/// The square root is taken only near the bound: `|v|² ≤ (15/16) C_v²`
+/// (computed) puts the rounded `|v|` below `C_v`, where the result is `v`
+/// itself, so the short path returns the very bits of the long one.
 pub(crate) fn saturate<T: RealField + Copy, const N: usize>(
     v: &SVector<T, N>,
     bound: T,
 ) -> SVector<T, N> {
-    let n = v.norm();
+    let squared = v.norm_squared();
+    let margin: T = nalgebra::convert(15.0 / 16.0);
+    if squared.is_finite() && squared <= margin * (bound * bound) {
+        return *v;
+    }
+    let n = squared.sqrt();
     if n > bound { v * (bound / n) } else { *v }
+}
+
+/// `F̄ = F(t, q, sat(v))` needs `sat(v)` only when `F` depends on `v`
+/// ([`Structure::forces_velocity_free`](crate::Structure::forces_velocity_free)).
+pub(crate) fn saturate_for<M, T, const N: usize, const K: usize>(
+    v: &SVector<T, N>,
+    bound: T,
+) -> SVector<T, N>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    if M::STRUCTURE.forces_velocity_free {
+        *v
+    } else {
+        saturate(v, bound)
+    }
 }
 
 /// `1 − e^{−x}` over `τ`, the injection gain that integrates
@@ -99,6 +125,7 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
     /// is unchanged, else factored now. `None` (the caller factors `M` where
     /// it evaluates it, and reports a failure there) for any other model or
     /// when `M` does not factor.
+    #[inline]
     fn mass<M, const K: usize>(&mut self, model: &M, q: &SVector<T, N>) -> Option<Cholesky<T, N>>
     where
         M: Model<N, K, Scalar = T>,
@@ -116,6 +143,48 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
             }
         }
     }
+}
+
+/// Rejects non-finite gaps `h` or Jacobian `J`.
+#[inline(always)]
+pub(crate) fn check_contact<T: RealField + Copy, const N: usize, const K: usize>(
+    h: &SVector<T, K>,
+    jac: &SMatrix<T, K, N>,
+) -> Result<(), T> {
+    finite(h, "h")?;
+    finite(jac, "J")?;
+    Ok(())
+}
+
+/// For a model whose `F` depends on none of `t`, `q`, `v`, `u`, with `M`
+/// factored as `chol` (constant): the free acceleration `−M⁻¹F`, the same
+/// bits at every point (`None` for another model, or a non-finite `F`).
+fn constant_free<M, T, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    t: T,
+    q: &SVector<T, N>,
+    chol: Cholesky<T, N>,
+) -> Option<Free<T, N>>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    let s = M::STRUCTURE;
+    let constant = s.mass_constant
+        && s.forces_velocity_free
+        && s.forces_configuration_free
+        && s.forces_time_free
+        && s.forces_input_free;
+    if !constant {
+        return None;
+    }
+    let forces = model.forces(t, q, &SVector::zeros(), u);
+    finite(&forces, "F").ok()?;
+    Some(Free {
+        chol,
+        accel: -chol.solve(&forces),
+    })
 }
 
 /// The mass matrix factored and the free acceleration `−M⁻¹ F̄` at one
@@ -245,6 +314,13 @@ where
     /// The factor of `M` when the model's `M` is constant (the same at
     /// every point of the interval): one factorization, or none, per update.
     pub mass: Option<Cholesky<T, N>>,
+    /// `M` factored and the free acceleration `−M⁻¹F`, the same at every
+    /// point, for a model whose `M` is constant and whose `F` depends on
+    /// none of `t`, `q`, `v`, `u` ([`Structure`](crate::Structure)): one
+    /// evaluation of `F` and one solve per update (`None` for any other
+    /// model, or when `F` is not finite: the stages then evaluate it and
+    /// report the failure where they always did).
+    pub constant: Option<Free<T, N>>,
 }
 
 /// What an observer remembers between updates, as the interval needs it.
@@ -255,7 +331,7 @@ pub(crate) struct Memory<'a, T: RealField + Copy, const N: usize, const K: usize
     pub t: T,
     pub q: SVector<T, N>,
     /// The observer's own `ê`, if it has one.
-    pub restitution: Option<SVector<T, K>>,
+    pub restitution: Option<&'a SVector<T, K>>,
     /// The last update's report.
     pub report: &'a UpdateReport<T, N, K>,
 }
@@ -268,6 +344,7 @@ where
     /// Checks one update's data (the measurement `q` at `t`, the input
     /// `u`, the model's parameters and restitution) and opens the interval
     /// `[t_k, t]` with an empty report; `cache` holds the observer's memos.
+    #[inline]
     pub fn begin(
         model: &'a M,
         u: &'a M::Input,
@@ -277,10 +354,14 @@ where
         q: &SVector<T, N>,
     ) -> Result<(Self, UpdateReport<T, N, K>), T> {
         let tau = check_update(model, memory.t, t, q, u)?;
-        let restitution = memory.restitution.unwrap_or_else(|| model.restitution());
+        let restitution = match memory.restitution {
+            Some(own) => *own,
+            None => model.restitution(),
+        };
         validate::restitution(&restitution)?;
         let gain = cache.gain(memory.params.l_d, tau);
         let mass = cache.mass::<M, K>(model, &memory.q);
+        let constant = mass.and_then(|chol| constant_free(model, u, memory.t, &memory.q, chol));
         let interval = Interval {
             model,
             u,
@@ -294,6 +375,7 @@ where
             uncertainty: memory.report.uncertainty(),
             gain,
             mass,
+            constant,
         };
         let mut report = UpdateReport::new(t, tau);
         report.gain = gain;
@@ -369,7 +451,8 @@ where
         Ok(minv_jt * solution.lambda)
     }
 
-    /// `M` factored and `−M⁻¹ F̄(t_k + s, p, w)`.
+    /// `M` factored and `−M⁻¹ F̄(t_k + s, p, w)` (the interval's
+    /// [`constant`](Self::constant) when it has one).
     pub fn free(
         &self,
         s: T,
@@ -377,9 +460,12 @@ where
         w: &SVector<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Free<T, N>, T> {
-        let w_bar = saturate(w, self.params.velocity_bound);
-        let (chol, forces) = self.dynamics(self.t0 + s, p, &w_bar)?;
         report.evaluations += 1;
+        if let Some(free) = self.constant {
+            return Ok(free);
+        }
+        let w_bar = saturate_for::<M, T, N, K>(w, self.params.velocity_bound);
+        let (chol, forces) = self.dynamics(self.t0 + s, p, &w_bar)?;
         let accel = -chol.solve(&forces);
         Ok(Free { chol, accel })
     }
@@ -405,8 +491,7 @@ where
     /// `(h(p), J(p))`, checked.
     pub fn contact(&self, p: &SVector<T, N>) -> Result<(SVector<T, K>, SMatrix<T, K, N>), T> {
         let (h, jac) = self.model.contact(p);
-        finite(&h, "h")?;
-        finite(&jac, "J")?;
+        check_contact(&h, &jac)?;
         Ok((h, jac))
     }
 
@@ -548,8 +633,8 @@ where
         touched: IndexSet<K>,
     ) -> Result<Classes<K>, T> {
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
-        let mut c = Classes::default();
         let band = self.params.contact_band();
+        let mut c = Classes::default();
         let noise_speed = self.noise_speed();
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
         let four: T = nalgebra::convert(4.0);
@@ -605,6 +690,29 @@ where
             }
         }
         Ok(c)
+    }
+
+    /// [`classify`](Self::classify), with its common case first and
+    /// inlined: every constraint clearly open and none touched, so all
+    /// free (the classes built whole where they are read: set one entry at
+    /// a time in `classify`, they cost a store-forwarding stall there).
+    #[inline(always)]
+    fn classes(
+        &self,
+        at: &Point<'_, T, N>,
+        (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
+        resolved: IndexSet<K>,
+        touched: IndexSet<K>,
+    ) -> Result<Classes<K>, T> {
+        let band = self.params.contact_band();
+        if touched.is_empty() && (0..K).all(|i| clearly_open(h[i], jac.row(i).norm_squared(), band))
+        {
+            return Ok(Classes {
+                free: IndexSet::full(K),
+                ..Classes::default()
+            });
+        }
+        self.classify(at, (h, jac), resolved, touched)
     }
 
     /// `h_i` along the segment at `σ`.
@@ -750,7 +858,10 @@ where
         v: &SVector<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<SVector<T, N>, T> {
-        let (h, jac) = self.contact(&self.q1)?;
+        // (the terms checked apart from the call: a checked pair returned
+        // through `Result` costs a store-forwarding stall on reading it)
+        let (h, jac) = self.model.contact(&self.q1);
+        check_contact(&h, &jac)?;
         let band = self.params.contact_band();
         let scale = T::default_epsilon() * nalgebra::convert(64.0);
         // the cheap tests first: a constraint the estimate does not

@@ -144,6 +144,10 @@
 //! Cost, with no constraint near: four evaluations of `(M, F̄)` and
 //! Cholesky solves, three of `(h, J)`. An impact adds two Runge–Kutta legs
 //! and a root search on `h`; a persistent contact, one small LCP per stage.
+//! Where the model's [`Structure`](crate::Structure) allows it, less: a
+//! constant `M` is factored once (a memo across updates), and with `F`
+//! also free of `t`, `q`, `v`, `u` one evaluation of `F` and one solve
+//! serve the four stages.
 //!
 //! ## [`SectionVii`](Discretization::SectionVii) (the baseline)
 //!

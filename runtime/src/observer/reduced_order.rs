@@ -6,7 +6,7 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Cache, Interval, Memory, saturate};
+use super::interval::{Cache, Interval, Memory, saturate, saturate_for};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
     UpdateReport, check_start,
@@ -181,7 +181,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         let (mass, forces) = interval.model.dynamics(
             interval.t0 + tau,
             q1,
-            &saturate(&v_pre, self.params.velocity_bound),
+            &saturate_for::<M, T, N, K>(&v_pre, self.params.velocity_bound),
             interval.u,
         );
         report.evaluations += 1;
@@ -405,7 +405,7 @@ where
             lcp: &self.lcp,
             t: self.t,
             q: self.smooth,
-            restitution: self.restitution,
+            restitution: self.restitution.as_ref(),
             report: &self.report,
         };
         let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;

@@ -47,7 +47,9 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     /// The injection gain `(1 − e^{−l_d τ}) / τ` the update used (the
     /// velocity correction is this times the innovation).
     pub gain: T,
-    /// Evaluations of the model's dynamics `(M, F)`.
+    /// Points at which the model's dynamics `(M, F̄)` were needed (for a
+    /// model with constant `M` and `F`, the memo of one evaluation serves
+    /// them all).
     pub evaluations: u32,
     /// Measurements skipped as outliers between the previous accepted
     /// update and this one.

@@ -623,6 +623,7 @@ enum Factor<T: RealField + Copy, const N: usize> {
 
 /// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored; `mass` is the Cholesky factor
 /// of `M`, reused when both Jacobians vanish.
+#[inline]
 fn iteration_matrix<T: RealField + Copy, const N: usize>(
     m: &SMatrix<T, N, N>,
     mass: Cholesky<T, N>,

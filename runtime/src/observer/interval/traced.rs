@@ -12,7 +12,7 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::IndexSet;
 use crate::model::Model;
 
-use super::{Contact, Crossing, Interval, Point, Result, Segment, UpdateReport};
+use super::{Contact, Crossing, Interval, Point, Result, Segment, UpdateReport, check_contact};
 
 /// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
 /// length `h`, with the persistent contacts `sliding` held at acceleration
@@ -93,14 +93,15 @@ where
             let last_round = round >= max_rounds;
             // CLASSIFY at (s, p, w)
             let free = self.free(s, &p, &w, report)?;
-            let (h, jac) = self.contact(&p)?;
+            let (h, jac) = self.model.contact(&p);
+            check_contact(&h, &jac)?;
             let point = Point {
                 s,
                 p: &p,
                 w: &w,
                 free: &free,
             };
-            let c = self.classify(&point, (&h, &jac), resolved, touched)?;
+            let c = self.classes(&point, (&h, &jac), resolved, touched)?;
             // IMPACT now, on the closed constraints met approaching
             if !c.approaching.is_empty() && !last_round {
                 let elastic = if report.impacts < max_impacts {
@@ -141,7 +142,8 @@ where
             report.contacts = report.contacts.union(c.sliding);
             // SEARCH for the first closing constraint along it
             if !last_round && report.impacts < max_impacts {
-                let (h1, jac1) = self.contact(&arc.p)?;
+                let (h1, jac1) = self.model.contact(&arc.p);
+                check_contact(&h1, &jac1)?;
                 let seg = Segment {
                     p0: p,
                     w0: w,

@@ -565,7 +565,7 @@ where
             lcp: &self.lcp,
             t: self.t,
             q: self.q,
-            restitution: self.restitution,
+            restitution: self.restitution.as_ref(),
             report: &self.report,
         };
         let (mut interval, mut report) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
