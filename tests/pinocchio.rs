@@ -1,7 +1,7 @@
 //! URDF models against Pinocchio: `tests/robots/ur5.yaml`,
 //! `tests/robots/panda.yaml` (URDFs from example-robot-data, shipped in
-//! `tests/robots/urdf/`) and `tests/robots/slider_arm.yaml` (a URDF written
-//! for the tests) compiled by `model!`, compared with the values that
+//! `tests/robots/urdf/`), `tests/robots/slider_arm.yaml` and
+//! `tests/robots/serial_12.yaml` (URDFs written for the tests) compiled by `model!`, compared with the values that
 //! `tests/pinocchio_reference.py` wrote with Pinocchio at 8 seeded
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
 //! matrix (Pinocchio's CRBA), `F = C v + G` (its nonlinear effects), `G`,
@@ -18,6 +18,7 @@ use serde_json::Value;
 moreau::model!(file = "tests/robots/ur5.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
 moreau::model!(file = "tests/robots/slider_arm.yaml");
+moreau::model!(file = "tests/robots/serial_12.yaml");
 
 const RTOL: f64 = 1e-10;
 
@@ -168,6 +169,19 @@ fn slider_arm_matches_pinocchio() {
         &SliderArm::<f64>::new(),
         "slider_arm",
         ["slide", "shoulder", "elbow", "side_slide"],
+    );
+}
+
+/// A generated chain of 12 revolute joints on six different axes
+/// (`tests/robots/urdf/synthetic/serial/gen.py`).
+#[test]
+fn serial_12_matches_pinocchio() {
+    compare(
+        &Serial12::<f64>::new(),
+        "serial_12",
+        [
+            "j1", "j2", "j3", "j4", "j5", "j6", "j7", "j8", "j9", "j10", "j11", "j12",
+        ],
     );
 }
 
