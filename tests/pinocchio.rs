@@ -6,8 +6,10 @@
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
 //! matrix (Pinocchio's CRBA), `F = C v + G` (its nonlinear effects), `G`,
 //! and the world positions and Jacobians of two points of two links (through
-//! the constraints `h` and `J`), every entry to 1e-10 relative (to the
-//! largest entry of the same quantity at the same configuration).
+//! the constraints `h` and `J`), and that `C` is the Christoffel one
+//! (`C(v) w = C(w) v`, with `C(v) v` Pinocchio's), every entry to 1e-10
+//! relative (to the largest entry of the same quantity at the same
+//! configuration).
 
 mod common;
 
@@ -89,6 +91,16 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
         let f = model.forces(0.0, &q, &v, &u);
         worst = worst.max(agree(f.as_slice(), &numbers(&s["nle"]), &at("C v + G")));
         let cv = model.coriolis(&q, &v) * v;
+        // The Christoffel C is the one with C(v) w = C(w) v (Γ_ijk
+        // symmetric in j, k) and C(v) v the velocity terms.
+        let w = SVector::<f64, N>::from_fn(|i, _| (0.7 * i as f64 + 0.3).sin());
+        let cvw = model.coriolis(&q, &v) * w;
+        let cwv = model.coriolis(&q, &w) * v;
+        worst = worst.max(agree(
+            cvw.as_slice(),
+            cwv.as_slice(),
+            &at("C(v) w = C(w) v"),
+        ));
         let cv_ref: Vec<f64> = numbers(&s["nle"])
             .iter()
             .zip(numbers(&s["G"]))

@@ -77,6 +77,7 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
         mass: built.dynamics.mass,
         bias: built.dynamics.bias,
         gravity: built.dynamics.gravity,
+        coriolis: built.dynamics.coriolis,
     });
     match Mechanics::derive_with(&mut graph, &system, recursive.as_ref()) {
         Ok(mechanics) => {

@@ -52,6 +52,8 @@ pub(crate) struct Dynamics {
     pub bias: Vec<Id>,
     /// `G`.
     pub gravity: Vec<Id>,
+    /// The Coriolis matrix of the Christoffel symbols of `M`.
+    pub coriolis: Vec<Vec<Id>>,
 }
 
 /// A spatial inertia about the world origin, in world coordinates.
@@ -84,7 +86,8 @@ pub(super) fn build(
     let a_world: Sv = [[zero; 3], down];
     let parents: Vec<Option<usize>> = bodies.iter().map(|b| b.parent).collect();
     let n = layout.n;
-    let bias = newton_euler(g, layout, &parents, &inertias, axes, a_world, n);
+    let (bias, motion) = newton_euler(g, layout, &parents, &inertias, axes, a_world, n);
+    let coriolis = coriolis(g, &parents, &inertias, axes, &motion, n);
     let composite = composite(g, &parents, &inertias);
     let mut gravity = vec![zero; n];
     for (axis, ic) in axes.iter().zip(&composite) {
@@ -99,6 +102,7 @@ pub(super) fn build(
         mass,
         bias,
         gravity,
+        coriolis,
     }
 }
 
@@ -111,17 +115,19 @@ fn newton_euler(
     axes: &[Axis],
     a_world: Sv,
     n: usize,
-) -> Vec<Id> {
+) -> (Vec<Id>, Vec<[Sv; 3]>) {
     let zero = g.constant(0.0);
     let still: Sv = [[zero; 3]; 2];
     let mut vel: Vec<Sv> = Vec::with_capacity(axes.len());
     let mut forces: Vec<Sv> = Vec::with_capacity(axes.len());
     let mut acc: Vec<Sv> = Vec::with_capacity(axes.len());
+    let mut motion = Vec::with_capacity(axes.len());
     for (i, axis) in axes.iter().enumerate() {
         let (mut v, mut a) = parents[i].map_or((still, a_world), |p| (vel[p], acc[p]));
+        let mut joint = still;
         if let Some((c, s)) = *axis {
             let dq = g.var(layout.id(Var::Velocity(c)));
-            let joint = sscale(g, s, dq);
+            joint = sscale(g, s, dq);
             v = sadd(g, v, joint);
             let turn = cross_motion(g, v, joint);
             a = sadd(g, a, turn);
@@ -131,6 +137,7 @@ fn newton_euler(
         let gyro = cross_force(g, v, momentum);
         forces.push(sadd(g, inert, gyro));
         vel.push(v);
+        motion.push([v, momentum, joint]);
         acc.push(a);
     }
     let mut bias = vec![zero; n];
@@ -144,7 +151,89 @@ fn newton_euler(
             forces[p] = sadd(g, forces[p], f);
         }
     }
-    bias
+    (bias, motion)
+}
+
+/// The Coriolis matrix of the Christoffel symbols, column by column: column
+/// `j` is `c(v, e_j)`, the polarization `c(v, w) = ½ (n(v + w) − n(v) −
+/// n(w))` of the Newton–Euler pass's velocity terms `n(v) = C(v) v`
+/// (gravity off), which is `Σ_k Γ_ijk v_k w_k` with `Γ` symmetric in `j,
+/// k`: the Christoffel `C`. Each of the pass's products of two velocities
+/// is polarized: with `W` the velocities of `w = e_j` (`S_j` on the subtree
+/// of joint `j`, zero elsewhere),
+///
+/// ```text
+/// 2 A_i = 2 A_parent + V_i ×m S_i w_i + W_i ×m S_i v_i
+/// 2 f_i = I_i (2 A_i) + V_i ×f (I_i W_i) + W_i ×f (I_i V_i)         C_kj = ½ S_k · Σ_subtree(k) 2 f
+/// ```
+///
+/// Outside the subtree of joint `j`, `W` and `A` vanish, so a column costs
+/// the size of that subtree plus the path to the root. `motion[i]` is body
+/// `i`'s velocity, momentum and joint velocity `(V_i, I_i V_i, S_i v_i)`.
+fn coriolis(
+    g: &mut Graph,
+    parents: &[Option<usize>],
+    inertias: &[Inertia],
+    axes: &[Axis],
+    motion: &[[Sv; 3]],
+    n: usize,
+) -> Vec<Vec<Id>> {
+    let zero = g.constant(0.0);
+    let half = g.constant(0.5);
+    let mut c = vec![vec![zero; n]; n];
+    let columns: Vec<usize> = axes.iter().filter_map(|a| a.map(|(c, _)| c)).collect();
+    for (col, &j) in columns.iter().enumerate() {
+        if columns[..col].contains(&j) {
+            continue;
+        }
+        // (W_i, 2 A_i) per body; `None` where both vanish.
+        let mut state: Vec<Option<[Sv; 2]>> = Vec::with_capacity(axes.len());
+        let mut forces: Vec<Option<Sv>> = Vec::with_capacity(axes.len());
+        for (i, axis) in axes.iter().enumerate() {
+            let mut here = parents[i].and_then(|p| state[p]);
+            if let Some((ci, s)) = *axis {
+                let [v, _, dq] = motion[i];
+                let [mut w, mut a] = here.unwrap_or([[[zero; 3]; 2]; 2]);
+                let mut moved = here.is_some();
+                if ci == j {
+                    w = sadd(g, w, s);
+                    let turn = cross_motion(g, v, s);
+                    a = sadd(g, a, turn);
+                    moved = true;
+                }
+                if moved {
+                    let carry = cross_motion(g, w, dq);
+                    a = sadd(g, a, carry);
+                    here = Some([w, a]);
+                }
+            }
+            state.push(here);
+            forces.push(here.map(|[w, a]| {
+                let [v, iv, _] = motion[i];
+                let iw = apply(g, &inertias[i], w);
+                let ia = apply(g, &inertias[i], a);
+                let x = cross_force(g, v, iw);
+                let y = cross_force(g, w, iv);
+                let xy = sadd(g, x, y);
+                sadd(g, ia, xy)
+            }));
+        }
+        for i in (0..axes.len()).rev() {
+            let Some(f) = forces[i] else { continue };
+            if let Some((ci, s)) = axes[i] {
+                let t = sdot(g, s, f);
+                let t = g.mul(half, t);
+                c[ci][j] = g.add(c[ci][j], t);
+            }
+            if let Some(p) = parents[i] {
+                forces[p] = Some(match forces[p] {
+                    Some(fp) => sadd(g, fp, f),
+                    None => f,
+                });
+            }
+        }
+    }
+    c
 }
 
 /// Each body's composite inertia: its own plus its descendants'.

@@ -240,10 +240,10 @@ impl Mechanics {
     /// [`Mechanics::derive`], with the mass matrix, bias forces and gravity
     /// of a kinematic tree built by recursions ([`Recursive`]) added to
     /// those derived from `T` and `V` (which then hold only what the model
-    /// writes besides the tree). `C` still comes from the Christoffel
-    /// symbols of the total `M`; `F` is the tree's bias `C v + G` plus the
-    /// Lagrangian route's `C v + G` of what `T` and `V` add, minus `Q` (see
-    /// the [`recursive`](Recursive) docs).
+    /// writes besides the tree). With no `T` written besides the tree, `C`
+    /// and `F = C v + G − Q` take the tree's `C` and bias; otherwise both
+    /// come from the Christoffel symbols of the total `M` (see the
+    /// [`Recursive`] docs).
     ///
     /// # Errors
     /// As [`Mechanics::derive`]; also [`MechanicsError::Shape`] if the
@@ -276,7 +276,10 @@ impl Mechanics {
         };
         // dm[i][j][k] = ∂M_ij/∂q_k, shared by C and ∂(M v)/∂q.
         let dm = mass_derivatives(g, sys, &mass);
-        let coriolis = coriolis(g, sys, &dm);
+        let coriolis = match tree {
+            Some(t) if !written_t => t.coriolis.clone(),
+            _ => coriolis(g, sys, &dm),
+        };
         let forces = match tree {
             // The tree's bias comes from the recursion; what the written
             // `V` adds is its gradient alone.

@@ -14,7 +14,7 @@
 //! |---|---|
 //! | `M` | the tree's `M` plus `∂²T/∂v²` of the written `T` |
 //! | `G` | the tree's `G` plus `∂V/∂q` of the written `V` |
-//! | `C` | the Christoffel symbols of the total `M` (as without a tree) |
+//! | `C` | the tree's `C` (Christoffel, built by the caller) when no `T` is written besides the tree; the Christoffel symbols of the total `M` otherwise |
 //! | `F` | the tree's bias `C v + G` plus `∂V/∂q − Q` when no `T` is written besides the tree; `C v + G − Q` from the total `M` otherwise |
 //! | `∂F/∂q`, `∂F/∂v`, `∂(M v)/∂q`, `J`, `∂(J v)/∂q` | differentiation of the above on the graph |
 //!
@@ -40,7 +40,7 @@ use super::{Lagrangian, MechanicsError};
 /// let w = g.constant(9.81);
 /// let weight = g.mul(me, w);
 /// let zero = g.constant(0.0);
-/// let tree = Recursive { mass: vec![vec![me]], bias: vec![weight], gravity: vec![weight] };
+/// let tree = Recursive { mass: vec![vec![me]], bias: vec![weight], gravity: vec![weight], coriolis: vec![vec![zero]] };
 /// let sys = Lagrangian { q: &[x], v: &[vx], kinetic: zero, potential: zero, applied: &[], gaps: &[] };
 /// let mech = Mechanics::derive_with(&mut g, &sys, Some(&tree)).unwrap();
 /// assert_eq!(mech.mass[0][0], me);
@@ -55,6 +55,9 @@ pub struct Recursive {
     pub bias: Vec<Id>,
     /// The gravity forces `G(q)`, `N`.
     pub gravity: Vec<Id>,
+    /// The Coriolis matrix `C(q, v)` of the Christoffel symbols of `mass`,
+    /// `N × N` (`C v` is the velocity part of `bias`).
+    pub coriolis: Vec<Vec<Id>>,
 }
 
 impl Recursive {
@@ -64,8 +67,13 @@ impl Recursive {
             ("tree mass", self.mass.len()),
             ("tree bias", self.bias.len()),
             ("tree gravity", self.gravity.len()),
+            ("tree coriolis", self.coriolis.len()),
         ];
-        let cols = self.mass.iter().map(|r| ("tree mass row", r.len()));
+        let cols = self
+            .mass
+            .iter()
+            .map(|r| ("tree mass row", r.len()))
+            .chain(self.coriolis.iter().map(|r| ("tree coriolis row", r.len())));
         for (what, found) in rows.into_iter().chain(cols) {
             if found != n {
                 return Err(MechanicsError::Shape {
