@@ -73,7 +73,7 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
         applied: &applied,
         gaps: &gaps,
     };
-    let recursive = (!model.bodies.is_empty()).then(|| Recursive {
+    let recursive = (!model.bodies.is_empty()).then_some(Recursive {
         mass: built.dynamics.mass,
         bias: built.dynamics.bias,
         gravity: built.dynamics.gravity,
