@@ -140,9 +140,9 @@ pub(crate) fn point(g: &mut Graph, pose: &Pose, local: V3) -> V3 {
 
 /// `Rz(yaw) Ry(pitch) Rx(roll)`.
 fn rpy(g: &mut Graph, [roll, pitch, yaw]: V3) -> M3 {
-    let (sr, cr) = (g.sin(roll), g.cos(roll));
-    let (sp, cp) = (g.sin(pitch), g.cos(pitch));
-    let (sy, cy) = (g.sin(yaw), g.cos(yaw));
+    let (sr, cr) = sin_cos(g, roll);
+    let (sp, cp) = sin_cos(g, pitch);
+    let (sy, cy) = sin_cos(g, yaw);
     let zero = g.constant(0.0);
     let one = g.constant(1.0);
     let nsr = g.neg(sr);
@@ -153,6 +153,29 @@ fn rpy(g: &mut Graph, [roll, pitch, yaw]: V3) -> M3 {
     let rz = [[cy, nsy, zero], [sy, cy, zero], [zero, zero, one]];
     let zy = mat_mul(g, &rz, &ry);
     mat_mul(g, &zy, &rx)
+}
+
+/// `(sin x, cos x)`; for a constant within 1e-12 of a multiple of π/2 (a
+/// URDF's `1.5707963267948966`), the exact values `0` and `±1`, so that a
+/// quarter turn folds to a permutation instead of leaving products with
+/// `cos(π/2) = 6.1e-17` in the generated code (a change of at most 1e-12
+/// in the entries of the rotation).
+fn sin_cos(g: &mut Graph, x: Id) -> (Id, Id) {
+    let Some(c) = g.as_const(x) else {
+        return (g.sin(x), g.cos(x));
+    };
+    let turns = (c / std::f64::consts::FRAC_PI_2).round();
+    let (s, c) = if (c - turns * std::f64::consts::FRAC_PI_2).abs() < 1e-12 {
+        match turns.rem_euclid(4.0) as u8 {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        }
+    } else {
+        c.sin_cos()
+    };
+    (g.constant(s), g.constant(c))
 }
 
 /// The rotation by `angle` about the unit `axis`:
