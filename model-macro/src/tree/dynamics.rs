@@ -1,5 +1,7 @@
-//! The tree's mass matrix by the composite-rigid-body algorithm and its
-//! bias forces `C v + G` by recursive Newton–Euler, on the graph, in world
+//! The tree's mass matrix by the composite-rigid-body algorithm, its bias
+//! forces `C v + G` by recursive Newton–Euler and its Coriolis matrix by
+//! Newton–Euler passes polarized in the velocities ([`coriolis`]), on the
+//! graph, in world
 //! coordinates (Featherstone, *Rigid Body Dynamics Algorithms*, 2008,
 //! chapters 5 and 6, with every spatial quantity expressed in the fixed
 //! world frame at its origin, so that no transform is needed between
@@ -32,7 +34,8 @@
 //! per body, velocities that gather all its ancestors' terms, and its second
 //! derivatives multiply that out; Panda (7 joints) took 36,495 operations
 //! and 5.5 s of expansion through the energies. The recursions share every
-//! ancestor's velocity, acceleration and composite inertia instead.
+//! ancestor's velocity, acceleration and composite inertia instead (Panda:
+//! 10,265 operations, 0.64 s; a 12-joint chain: 29,187, 1.7 s).
 
 use moreau_sym::{Graph, Id};
 
