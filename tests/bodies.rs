@@ -2,7 +2,8 @@
 //! the energies written by hand. `tests/robots/two_link.yaml` (a tree with
 //! a fixed tip body and `position_x`/`position_z` constraints) against
 //! `tests/robots/two_link_energies.yaml` (the same arm, T and V by hand):
-//! M, C, G, F, h and J agree at seeded configurations to 1e-12 relative;
+//! M, C, G, F, ∂F/∂q, ∂F/∂v, h and J agree at seeded configurations to
+//! 1e-12 relative;
 //! the same tree written inline gives the same values bit for bit; energies
 //! written beside the tree add their hand-derived Lagrangian terms.
 
@@ -129,6 +130,28 @@ fn tree_matches_energies_written_by_hand() {
                 "F",
                 tree.forces(0.0, &q, &v, &u).as_slice().to_vec(),
                 hand.forces(0.0, &q, &v, &u).as_slice().to_vec(),
+            ),
+            (
+                "∂F/∂q",
+                tree.linearization(0.0, &q, &v, &u)
+                    .forces_dq
+                    .as_slice()
+                    .to_vec(),
+                hand.linearization(0.0, &q, &v, &u)
+                    .forces_dq
+                    .as_slice()
+                    .to_vec(),
+            ),
+            (
+                "∂F/∂v",
+                tree.linearization(0.0, &q, &v, &u)
+                    .forces_dv
+                    .as_slice()
+                    .to_vec(),
+                hand.linearization(0.0, &q, &v, &u)
+                    .forces_dv
+                    .as_slice()
+                    .to_vec(),
             ),
             (
                 "h",

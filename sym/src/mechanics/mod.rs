@@ -288,7 +288,10 @@ impl Mechanics {
         };
         let jacobian = g.jacobian(sys.gaps, sys.q);
         let force_dq = g.jacobian(&forces, sys.q);
-        let force_dv = g.jacobian(&forces, sys.v);
+        let force_dv = match tree {
+            Some(t) if !written_t => t.forces_dv(g, sys, &coriolis),
+            _ => g.jacobian(&forces, sys.v),
+        };
         // ∂(M v)_i/∂q_j = Σ_k ∂M_ik/∂q_j v_k.
         let mass_dq = (0..n)
             .map(|i| (0..n).map(|j| contract(g, sys, &|k| dm[i][k][j])).collect())

@@ -16,7 +16,8 @@
 //! | `G` | the tree's `G` plus `∂V/∂q` of the written `V` |
 //! | `C` | the tree's `C` (Christoffel, built by the caller) when no `T` is written besides the tree; the Christoffel symbols of the total `M` otherwise |
 //! | `F` | the tree's bias `C v + G` plus `∂V/∂q − Q` when no `T` is written besides the tree; `C v + G − Q` from the total `M` otherwise |
-//! | `∂F/∂q`, `∂F/∂v`, `∂(M v)/∂q`, `J`, `∂(J v)/∂q` | differentiation of the above on the graph |
+//! | `∂F/∂v` | `2 C − ∂Q/∂v` when no `T` is written besides the tree (the bias is quadratic in `v` through the Christoffel symbols); differentiation of `F` otherwise |
+//! | `∂F/∂q`, `∂(M v)/∂q`, `J`, `∂(J v)/∂q` | differentiation of the above on the graph |
 //!
 //! The graph's derivatives are forward-mode and memoized per node, so each
 //! derivative of a recursion costs at most a constant times the nodes that
@@ -118,6 +119,36 @@ impl Recursive {
             .map(|(&a, &b)| g.add(a, b))
             .collect();
         (momentum, mass, gravity)
+    }
+
+    /// `∂F/∂v = 2 C − ∂Q/∂v`: the velocity terms of `bias` are
+    /// `n(v) = Σ_jk Γ_ijk v_j v_k` with `Γ` symmetric in `j, k`, so
+    /// `∂n_i/∂v_j = 2 Σ_k Γ_ijk v_k = 2 C_ij`, and `∂V/∂q` does not depend
+    /// on `v`. Saves differentiating the Newton–Euler pass in `v`.
+    pub(super) fn forces_dv(
+        &self,
+        g: &mut Graph,
+        sys: &Lagrangian<'_>,
+        coriolis: &[Vec<Id>],
+    ) -> Vec<Vec<Id>> {
+        let two = g.constant(2.0);
+        (0..coriolis.len())
+            .map(|i| {
+                let dq: Vec<Id> = match sys.applied.get(i) {
+                    Some(&q) => g.gradient(q, sys.v),
+                    None => Vec::new(),
+                };
+                (0..coriolis.len())
+                    .map(|j| {
+                        let c = g.mul(two, coriolis[i][j]);
+                        match dq.get(j) {
+                            Some(&d) => g.sub(c, d),
+                            None => c,
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
     }
 
     /// `F = bias + ∂V/∂q − Q`, `written` the gradient of the written `V`.
