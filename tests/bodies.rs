@@ -2,8 +2,10 @@
 //! the energies written by hand. `tests/robots/two_link.yaml` (a tree with
 //! a fixed tip body and `position_x`/`position_z` constraints) against
 //! `tests/robots/two_link_energies.yaml` (the same arm, T and V by hand):
-//! M, C, G, F, h and J agree at seeded configurations to 1e-12 relative;
-//! the same tree written inline gives the same values bit for bit.
+//! M, C, G, F, ∂F/∂q, ∂F/∂v, h and J agree at seeded configurations to
+//! 1e-12 relative;
+//! the same tree written inline gives the same values bit for bit; energies
+//! written beside the tree add their hand-derived Lagrangian terms.
 
 use moreau::Model;
 use nalgebra::{SVector, Vector2};
@@ -37,6 +39,43 @@ moreau::model! {
         },
         tip: { parent: lower, joint: fixed, xyz: [0, 0, -l2], rpy: [0.3, -0.2, 1.1], mass: 0.25 },
     }
+    applied { a2: -0.1 * da2 }
+    constraints {
+        floor: position_z(tip) + 1.2 >= 0,
+        wall: 1.1 - position_x(lower, 0, 0, -l2) >= 0,
+    }
+    restitution = 0.5;
+}
+
+moreau::model! {
+    /// `TwoLinkInline` with energies written beside the tree: a term
+    /// `½ μ a1² da2²` in `T` and a spring `½ k a2²` in `V`.
+    pub struct TwoLinkMixed;
+    parameters { m1: 1.5, m2: 0.7, l1: 0.9, l2: 0.6, g: 9.81, mu: 0.3, k: 2.0 }
+    gravity = [0, 0, -g];
+    bodies {
+        upper: {
+            parent: world,
+            joint: revolute(a1: w1),
+            axis: [0, -1, 0],
+            xyz: [0, 0, 0.3],
+            mass: m1,
+            com: [0, 0, -l1 / 2],
+            inertia: [m1 * l1^2 / 12, 0, 0, m1 * l1^2 / 12, 0, 0],
+        },
+        lower: {
+            parent: upper,
+            joint: revolute(a2),
+            axis: [0, -2, 0],
+            xyz: [0, 0, -l1],
+            mass: m2,
+            com: [0, 0, -l2 / 2],
+            inertia: [m2 * l2^2 / 12, 0, 0, m2 * l2^2 / 12, 0, 0],
+        },
+        tip: { parent: lower, joint: fixed, xyz: [0, 0, -l2], rpy: [0.3, -0.2, 1.1], mass: 0.25 },
+    }
+    kinetic = 0.5 * mu * a1^2 * da2^2;
+    potential = 0.5 * k * a2^2;
     applied { a2: -0.1 * da2 }
     constraints {
         floor: position_z(tip) + 1.2 >= 0,
@@ -91,6 +130,28 @@ fn tree_matches_energies_written_by_hand() {
                 "F",
                 tree.forces(0.0, &q, &v, &u).as_slice().to_vec(),
                 hand.forces(0.0, &q, &v, &u).as_slice().to_vec(),
+            ),
+            (
+                "∂F/∂q",
+                tree.linearization(0.0, &q, &v, &u)
+                    .forces_dq
+                    .as_slice()
+                    .to_vec(),
+                hand.linearization(0.0, &q, &v, &u)
+                    .forces_dq
+                    .as_slice()
+                    .to_vec(),
+            ),
+            (
+                "∂F/∂v",
+                tree.linearization(0.0, &q, &v, &u)
+                    .forces_dv
+                    .as_slice()
+                    .to_vec(),
+                hand.linearization(0.0, &q, &v, &u)
+                    .forces_dv
+                    .as_slice()
+                    .to_vec(),
             ),
             (
                 "h",
@@ -149,4 +210,58 @@ fn body_numbers_follow_their_parameters() {
         close(*x, *y, "M with m2 = 2.5");
     }
     assert!((tree.mass(&q)[(1, 1)] - TwoLinkTree::<f64>::new().mass(&q)[(1, 1)]).abs() > 0.1);
+}
+
+/// Energies written beside a tree add their Lagrangian terms to the tree's:
+/// `M` gains `μ a1²` at `[1,1]`, `G` and `F` gain `k a2` in row 1, and `C`
+/// gains the Christoffel matrix of that `M`, `μ a1 [[0, −da2], [da2, w1]]`
+/// (worked out by hand), at seeded states.
+#[test]
+fn energies_written_beside_a_tree_add_to_it() {
+    let (mu, k) = (0.3, 2.0);
+    let tree = TwoLinkInline::<f64>::new();
+    let mixed = TwoLinkMixed::<f64>::new();
+    let mut seed = 0x1234_5678_9abc_def1_u64;
+    for _ in 0..20 {
+        let q = Vector2::new(3.0 * uniform(&mut seed), 3.0 * uniform(&mut seed));
+        let v = Vector2::new(2.0 * uniform(&mut seed), 2.0 * uniform(&mut seed));
+        let u = SVector::<f64, 0>::zeros();
+        let mut m = tree.mass(&q);
+        m[(1, 1)] += mu * q[0] * q[0];
+        let mut c = tree.coriolis(&q, &v);
+        c[(0, 1)] -= mu * q[0] * v[1];
+        c[(1, 0)] += mu * q[0] * v[1];
+        c[(1, 1)] += mu * q[0] * v[0];
+        let mut g = tree.gravity(&q);
+        g[1] += k * q[1];
+        let f = tree.forces(0.0, &q, &v, &u) + Vector2::new(0.0, k * q[1]) + c * v
+            - tree.coriolis(&q, &v) * v;
+        let pairs = [
+            (
+                "M",
+                mixed.mass(&q).as_slice().to_vec(),
+                m.as_slice().to_vec(),
+            ),
+            (
+                "C",
+                mixed.coriolis(&q, &v).as_slice().to_vec(),
+                c.as_slice().to_vec(),
+            ),
+            (
+                "G",
+                mixed.gravity(&q).as_slice().to_vec(),
+                g.as_slice().to_vec(),
+            ),
+            (
+                "F",
+                mixed.forces(0.0, &q, &v, &u).as_slice().to_vec(),
+                f.as_slice().to_vec(),
+            ),
+        ];
+        for (what, a, b) in pairs {
+            for (x, y) in a.iter().zip(&b) {
+                close(*x, *y, what);
+            }
+        }
+    }
 }

@@ -13,6 +13,9 @@ use moreau::{
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
 
+// A URDF robot, whose dynamics the recursions over its tree build.
+moreau::model!(file = "tests/robots/ur5.yaml");
+
 /// Counts allocations made on a thread while it is armed.
 struct Counting;
 
@@ -103,6 +106,17 @@ fn stepping_every_shipped_model_allocates_nothing() {
     );
     let (q, v) = Arm3::<f64>::initial_state();
     assert_eq!(run::<_, 3, 1, 3>(&Arm3::<f64>::default(), q, v, 2000), 0);
+}
+
+/// A robot from its URDF (the UR5 falling onto its table from the zero
+/// configuration): stepping, evaluating and observing allocate nothing.
+#[test]
+fn a_urdf_robot_allocates_nothing() {
+    let (q, v) = (SVector::zeros(), SVector::zeros());
+    let ur5 = Ur5::<f64>::new();
+    assert_eq!(run::<_, 6, 6, 0>(&ur5, q, v, 2000), 0);
+    let (count, impacts) = observe::<_, 6, 6, 0>(&ur5, q, v, 20_000);
+    assert_eq!((count, impacts > 0), (0, true));
 }
 
 /// Runs a shipped model's plant for `steps` steps of 0.1 ms, then feeds

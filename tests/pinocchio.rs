@@ -1,23 +1,28 @@
 //! URDF models against Pinocchio: `tests/robots/ur5.yaml`,
 //! `tests/robots/panda.yaml` (URDFs from example-robot-data, shipped in
-//! `tests/robots/urdf/`) and `tests/robots/slider_arm.yaml` (a URDF written
-//! for the tests) compiled by `model!`, compared with the values that
+//! `tests/robots/urdf/`), `tests/robots/slider_arm.yaml` and
+//! `tests/robots/serial_12.yaml` (URDFs written for the tests) compiled by `model!`, compared with the values that
 //! `tests/pinocchio_reference.py` wrote with Pinocchio at 8 seeded
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
 //! matrix (Pinocchio's CRBA), `F = C v + G` (its nonlinear effects), `G`,
 //! and the world positions and Jacobians of two points of two links (through
-//! the constraints `h` and `J`), every entry to 1e-10 relative (to the
-//! largest entry of the same quantity at the same configuration).
+//! the constraints `h` and `J`), and that `C` is the Christoffel one
+//! (`C(v) w = C(w) v`, with `C(v) v` Pinocchio's), every entry to 1e-10
+//! relative (to the largest entry of the same quantity at the same
+//! configuration). For two of the robots, the derivatives built from the
+//! recursions (`∂F/∂q`, `∂F/∂v`, `∂(M v)/∂q`, `∂(J v)/∂q`) against central
+//! differences, and `Ṁ − 2C` skew-symmetric.
 
 mod common;
 
-use moreau::Model;
-use nalgebra::SVector;
+use moreau::{Model, Sensitivities};
+use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
 
 moreau::model!(file = "tests/robots/ur5.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
 moreau::model!(file = "tests/robots/slider_arm.yaml");
+moreau::model!(file = "tests/robots/serial_12.yaml");
 
 const RTOL: f64 = 1e-10;
 
@@ -88,6 +93,16 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
         let f = model.forces(0.0, &q, &v, &u);
         worst = worst.max(agree(f.as_slice(), &numbers(&s["nle"]), &at("C v + G")));
         let cv = model.coriolis(&q, &v) * v;
+        // The Christoffel C is the one with C(v) w = C(w) v (Γ_ijk
+        // symmetric in j, k) and C(v) v the velocity terms.
+        let w = SVector::<f64, N>::from_fn(|i, _| (0.7 * i as f64 + 0.3).sin());
+        let cvw = model.coriolis(&q, &v) * w;
+        let cwv = model.coriolis(&q, &w) * v;
+        worst = worst.max(agree(
+            cvw.as_slice(),
+            cwv.as_slice(),
+            &at("C(v) w = C(w) v"),
+        ));
         let cv_ref: Vec<f64> = numbers(&s["nle"])
             .iter()
             .zip(numbers(&s["G"]))
@@ -171,10 +186,103 @@ fn slider_arm_matches_pinocchio() {
     );
 }
 
+/// A generated chain of 12 revolute joints on six different axes
+/// (`tests/robots/urdf/synthetic/serial/gen.py`).
+#[test]
+fn serial_12_matches_pinocchio() {
+    compare(
+        &Serial12::<f64>::new(),
+        "serial_12",
+        [
+            "j1", "j2", "j3", "j4", "j5", "j6", "j7", "j8", "j9", "j10", "j11", "j12",
+        ],
+    );
+}
+
 #[test]
 fn coordinates_are_the_urdf_joints_with_generated_velocities() {
     let info = Ur5::<f64>::INFO;
     assert_eq!(info.coordinates[0], "shoulder_pan_joint");
     assert_eq!(info.velocities[0], "dshoulder_pan_joint");
     assert_eq!(Panda::<f64>::INFO.constraints[2], "table");
+}
+
+/// Central difference of `f` at `x` along coordinate `j` (step 1e-6
+/// relative to `x_j`).
+fn central<const N: usize, const R: usize>(
+    f: impl Fn(&SVector<f64, N>) -> SVector<f64, R>,
+    x: &SVector<f64, N>,
+    j: usize,
+) -> SVector<f64, R> {
+    let step = 1e-6 * x[j].abs().max(1.0);
+    let (mut plus, mut minus) = (*x, *x);
+    plus[j] += step;
+    minus[j] -= step;
+    (f(&plus) - f(&minus)) / (2.0 * step)
+}
+
+/// The derivatives the graph builds from the recursions (`∂F/∂q`, `∂F/∂v`,
+/// `∂(M v)/∂q`, `∂(J v)/∂q`) against central differences of the generated
+/// `F`, `M v` and `J v`, and `Ṁ − 2C` skew-symmetric (`Ṁ` by central
+/// differences along `v`), at the fixture's states; 1e-6 relative to the
+/// largest entry, well above a central difference's O(1e-10) error.
+fn derivatives_match_finite_differences<M, const N: usize>(model: &M, robot: &str)
+where
+    M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>> + Sensitivities<N, 6>,
+{
+    let data = fixture(robot);
+    let u = SVector::<f64, 0>::zeros();
+    for (k, s) in data["samples"].as_array().unwrap().iter().enumerate() {
+        let q = SVector::<f64, N>::from_iterator(numbers(&s["q"]));
+        let v = SVector::<f64, N>::from_iterator(numbers(&s["v"]));
+        let lin = model.linearization(0.0, &q, &v, &u);
+        let mass_dq = model.mass_dq(&q, &v);
+        let jacobian_dq = model.jacobian_dq(&q, &v);
+        let mut fd = [
+            SMatrix::<f64, N, N>::zeros(),
+            SMatrix::zeros(),
+            SMatrix::zeros(),
+        ];
+        let mut fd_jv = SMatrix::<f64, 6, N>::zeros();
+        for j in 0..N {
+            fd[0].set_column(j, &central(|x| model.forces(0.0, x, &v, &u), &q, j));
+            fd[1].set_column(j, &central(|x| model.forces(0.0, &q, x, &u), &v, j));
+            fd[2].set_column(j, &central(|x| model.mass(x) * v, &q, j));
+            fd_jv.set_column(j, &central(|x| model.gap_jacobian(x) * v, &q, j));
+        }
+        let step = 1e-6;
+        let mdot = (model.mass(&(q + step * v)) - model.mass(&(q - step * v))) / (2.0 * step);
+        let c = model.coriolis(&q, &v);
+        let skew = mdot - 2.0 * c;
+        let minus_transpose = -skew.transpose();
+        let pairs: [(&str, &[f64], &[f64]); 5] = [
+            ("∂F/∂q", lin.forces_dq.as_slice(), fd[0].as_slice()),
+            ("∂F/∂v", lin.forces_dv.as_slice(), fd[1].as_slice()),
+            ("∂(M v)/∂q", mass_dq.as_slice(), fd[2].as_slice()),
+            ("∂(J v)/∂q", jacobian_dq.as_slice(), fd_jv.as_slice()),
+            ("Ṁ − 2C", skew.as_slice(), minus_transpose.as_slice()),
+        ];
+        for (what, ours, reference) in pairs {
+            let scale = reference
+                .iter()
+                .chain(ours)
+                .fold(1e-300_f64, |m, x| m.max(x.abs()));
+            for (a, b) in ours.iter().zip(reference) {
+                assert!(
+                    (a - b).abs() <= 1e-6 * scale,
+                    "{robot} sample {k}: {what}: {a} vs {b}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn slider_arm_derivatives_match_finite_differences() {
+    derivatives_match_finite_differences(&SliderArm::<f64>::new(), "slider_arm");
+}
+
+#[test]
+fn serial_12_derivatives_match_finite_differences() {
+    derivatives_match_finite_differences(&Serial12::<f64>::new(), "serial_12");
 }

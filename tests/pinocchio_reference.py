@@ -72,6 +72,13 @@ ROBOTS = [
         [],
         [("tool", [0.02, 0.01, 0.05]), ("side", [0.0, 0.1, -0.03])],
     ),
+    (
+        "serial_12",
+        "tests/robots/urdf/synthetic/serial/serial_12.urdf",
+        None,
+        [],
+        [("l12", [0.02, -0.01, 0.1]), ("l6", [0.0, 0.0, 0.0])],
+    ),
 ]
 
 

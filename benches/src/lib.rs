@@ -181,3 +181,82 @@ constructors! {
     /// The 12-link chain.
     chain12: chain12_eval, 12, 12;
 }
+
+/// Pinocchio's C++ (CRBA and nonlinear effects) through `pinocchio/shim.cpp`,
+/// built by `build.rs` when the `pin` wheel is found.
+#[cfg(pinocchio)]
+pub mod pinocchio {
+    use std::ffi::{CString, c_char, c_int, c_void};
+
+    unsafe extern "C" {
+        fn moreau_pin_load(path: *const c_char) -> *mut c_void;
+        fn moreau_pin_nv(robot: *const c_void) -> c_int;
+        fn moreau_pin_crba_nle(
+            robot: *mut c_void,
+            q: *const f64,
+            v: *const f64,
+            mass: *mut f64,
+            nle: *mut f64,
+        );
+        fn moreau_pin_free(robot: *mut c_void);
+    }
+
+    /// A Pinocchio model and its data, loaded from the archive that
+    /// `build.rs` saved as `OUT_DIR/<name>.txt`.
+    pub struct Robot {
+        handle: *mut c_void,
+        nv: usize,
+    }
+
+    impl Robot {
+        /// The robot saved as `name` (`ur5`, `panda`, `serial_12`).
+        ///
+        /// # Panics
+        /// If the archive is missing or cannot be loaded.
+        #[must_use]
+        pub fn load(name: &str) -> Robot {
+            let path = format!("{}/{name}.txt", env!("OUT_DIR"));
+            let c = CString::new(path.clone()).expect("no NUL in the path");
+            // SAFETY: a NUL-terminated path; the shim returns null on failure.
+            let handle = unsafe { moreau_pin_load(c.as_ptr()) };
+            assert!(!handle.is_null(), "Pinocchio cannot load {path}");
+            // SAFETY: a live handle.
+            let nv = usize::try_from(unsafe { moreau_pin_nv(handle) }).expect("nv ≥ 0");
+            Robot { handle, nv }
+        }
+
+        /// The number of coordinates.
+        #[must_use]
+        pub fn nv(&self) -> usize {
+            self.nv
+        }
+
+        /// `M(q)` (column-major, both triangles) into `mass` and
+        /// `C(q, v) v + G(q)` into `nle`: `pinocchio::crba` then
+        /// `pinocchio::nonLinearEffects`.
+        ///
+        /// # Panics
+        /// If a slice does not have the robot's size.
+        pub fn crba_nle(&mut self, q: &[f64], v: &[f64], mass: &mut [f64], nle: &mut [f64]) {
+            let n = self.nv;
+            assert!(q.len() == n && v.len() == n && mass.len() == n * n && nle.len() == n);
+            // SAFETY: a live handle and buffers of the sizes checked above.
+            unsafe {
+                moreau_pin_crba_nle(
+                    self.handle,
+                    q.as_ptr(),
+                    v.as_ptr(),
+                    mass.as_mut_ptr(),
+                    nle.as_mut_ptr(),
+                );
+            }
+        }
+    }
+
+    impl Drop for Robot {
+        fn drop(&mut self) {
+            // SAFETY: the handle was made by moreau_pin_load and is freed once.
+            unsafe { moreau_pin_free(self.handle) }
+        }
+    }
+}

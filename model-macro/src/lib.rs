@@ -13,7 +13,7 @@
 //! | front ends | `front::yaml`, `front::inline` (a URDF through `front::urdf`) | YAML text, or tokens | `ModelSpec` (`spec.rs`): the model as written, every name and expression with its location |
 //! | checks | `check` | `ModelSpec` and its `Scope` | errors (every one at once), nothing else |
 //! | resolution | `resolve` | a checked `ModelSpec` | `Resolved` (`resolve.rs`): expressions over typed `Symbol`s, `kinetic` required, per-coordinate applied forces |
-//! | lowering | `lower` (a kinematic tree's T and V: `tree`) | `Resolved` | the symbolic graph and every derived quantity (`moreau_sym::Mechanics`, laid out by `moreau_sym::Layout`) |
+//! | lowering | `lower` (a kinematic tree's M, C, G, C v + G by recursions: `tree`) | `Resolved` | the symbolic graph and every derived quantity (`moreau_sym::Mechanics`, laid out by `moreau_sym::Layout`) |
 //! | emission | `emit` | `Resolved` and the lowered graph | tokens: the type, its `impl`s, its docs (with the listing of `eval`) |
 //!
 //! `expand` chains them (`expand::compile`), and on error emits the

@@ -6,7 +6,7 @@
 //! variables: each is built once and its node reused wherever it is named.
 
 use moreau_sym::{
-    Graph, Id, Lagrangian, Mechanics, MechanicsError, Node, Operand, Schedule, VarId,
+    Graph, Id, Lagrangian, Mechanics, MechanicsError, Node, Operand, Recursive, Schedule, VarId,
 };
 
 use crate::ctxt::Ctxt;
@@ -41,19 +41,16 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
         let id = b.expr(d)?;
         b.definitions.push(id);
     }
+    // The tree's M, C v + G and G come from its recursions; T and V hold
+    // only what the model writes besides it.
+    let zero = b.graph.constant(0.0);
     let kinetic = match &model.kinetic {
-        Some(k) => {
-            let k = b.expr(k)?;
-            b.graph.add(k, built.kinetic)
-        }
-        None => built.kinetic,
+        Some(k) => b.expr(k)?,
+        None => zero,
     };
     let potential = match &model.potential {
-        Some(p) => {
-            let p = b.expr(p)?;
-            b.graph.add(p, built.potential)
-        }
-        None => built.potential,
+        Some(p) => b.expr(p)?,
+        None => zero,
     };
     let mut applied = Vec::with_capacity(layout.n);
     for a in &model.applied {
@@ -76,7 +73,13 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
         applied: &applied,
         gaps: &gaps,
     };
-    match Mechanics::derive(&mut graph, &system) {
+    let recursive = (!model.bodies.is_empty()).then_some(Recursive {
+        mass: built.dynamics.mass,
+        bias: built.dynamics.bias,
+        gravity: built.dynamics.gravity,
+        coriolis: built.dynamics.coriolis,
+    });
+    match Mechanics::derive_with(&mut graph, &system, recursive.as_ref()) {
         Ok(mechanics) => {
             check_mass_diagonal(cx, model, &graph, &mechanics)?;
             check_finite_constants(cx, model, &graph, &mechanics)?;

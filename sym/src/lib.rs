@@ -60,6 +60,6 @@ pub mod schedule;
 mod testing;
 
 pub use graph::Graph;
-pub use mechanics::{Lagrangian, Layout, Mechanics, MechanicsError, Quantity, Slot};
+pub use mechanics::{Lagrangian, Layout, Mechanics, MechanicsError, Quantity, Recursive, Slot};
 pub use node::{Func, Function, Id, Node, Op, VarId};
 pub use schedule::{Instr, Operand, Schedule};

@@ -497,6 +497,30 @@ where
     }
 }
 
+impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
+    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
+    #[must_use]
+    pub fn estimate(&self) -> Estimate<T, N> {
+        Estimate {
+            t: self.t,
+            q: self.q_hat,
+            v: self.v,
+        }
+    }
+
+    /// What the last successful update did (also [`Observer::report`]).
+    #[must_use]
+    pub fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
+    /// The settings (also [`Observer::params`]).
+    #[must_use]
+    pub fn params(&self) -> &ObserverParams<T> {
+        &self.params
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -528,29 +552,5 @@ mod tests {
                 "{ours} vs {exact}"
             );
         }
-    }
-}
-
-impl<T: RealField + Copy, const N: usize, const K: usize> FullOrder<T, N, K> {
-    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
-    #[must_use]
-    pub fn estimate(&self) -> Estimate<T, N> {
-        Estimate {
-            t: self.t,
-            q: self.q_hat,
-            v: self.v,
-        }
-    }
-
-    /// What the last successful update did (also [`Observer::report`]).
-    #[must_use]
-    pub fn report(&self) -> &UpdateReport<T, N, K> {
-        &self.report
-    }
-
-    /// The settings (also [`Observer::params`]).
-    #[must_use]
-    pub fn params(&self) -> &ObserverParams<T> {
-        &self.params
     }
 }

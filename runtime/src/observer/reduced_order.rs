@@ -448,6 +448,30 @@ where
     }
 }
 
+impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
+    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
+    #[must_use]
+    pub fn estimate(&self) -> Estimate<T, N> {
+        Estimate {
+            t: self.t,
+            q: self.q,
+            v: self.v,
+        }
+    }
+
+    /// What the last successful update did (also [`Observer::report`]).
+    #[must_use]
+    pub fn report(&self) -> &UpdateReport<T, N, K> {
+        &self.report
+    }
+
+    /// The settings (also [`Observer::params`]).
+    #[must_use]
+    pub fn params(&self) -> &ObserverParams<T> {
+        &self.params
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -610,29 +634,5 @@ mod tests {
         // single precision: positions to 6e-8 m over τ = 1 ms are velocities
         // to ~1e-4 m/s, times the gain's filtering
         assert!(worst < 1e-2, "{worst}");
-    }
-}
-
-impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> {
-    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
-    #[must_use]
-    pub fn estimate(&self) -> Estimate<T, N> {
-        Estimate {
-            t: self.t,
-            q: self.q,
-            v: self.v,
-        }
-    }
-
-    /// What the last successful update did (also [`Observer::report`]).
-    #[must_use]
-    pub fn report(&self) -> &UpdateReport<T, N, K> {
-        &self.report
-    }
-
-    /// The settings (also [`Observer::params`]).
-    #[must_use]
-    pub fn params(&self) -> &ObserverParams<T> {
-        &self.params
     }
 }

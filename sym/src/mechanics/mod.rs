@@ -52,8 +52,10 @@ use core::fmt;
 
 mod layout;
 mod lincomb;
+mod recursive;
 
 pub use layout::{Layout, Quantity, Slot};
+pub use recursive::Recursive;
 
 use crate::graph::{Graph, TrigForm};
 use crate::node::{Id, VarId};
@@ -238,7 +240,29 @@ impl Mechanics {
     /// [`MechanicsError::LinearTerm`] or [`MechanicsError::VelocityFreeTerm`]
     /// if `T` is not a quadratic form in `v`.
     pub fn derive(g: &mut Graph, sys: &Lagrangian<'_>) -> Result<Mechanics, MechanicsError> {
+        Mechanics::derive_with(g, sys, None)
+    }
+
+    /// [`Mechanics::derive`], with the mass matrix, bias forces and gravity
+    /// of a kinematic tree built by recursions ([`Recursive`]) added to
+    /// those derived from `T` and `V` (which then hold only what the model
+    /// writes besides the tree). With no `T` written besides the tree, `C`
+    /// and `F = C v + G − Q` take the tree's `C` and bias; otherwise both
+    /// come from the Christoffel symbols of the total `M` (see the
+    /// [`Recursive`] docs).
+    ///
+    /// # Errors
+    /// As [`Mechanics::derive`]; also [`MechanicsError::Shape`] if the
+    /// tree's quantities do not have one row per coordinate.
+    pub fn derive_with(
+        g: &mut Graph,
+        sys: &Lagrangian<'_>,
+        tree: Option<&Recursive>,
+    ) -> Result<Mechanics, MechanicsError> {
         let n = sys.q.len();
+        if let Some(t) = tree {
+            t.check(n)?;
+        }
         for (what, found) in [("v", sys.v.len()), ("applied", sys.applied.len())] {
             if found != n && !(what == "applied" && found == 0) {
                 return Err(MechanicsError::Shape {
@@ -250,15 +274,31 @@ impl Mechanics {
         }
         let (momentum, mass) = mass_matrix(g, sys)?;
         check_form(g, sys, &momentum)?;
+        let written_t = !g.is_zero(sys.kinetic);
+        let potential = TrigForm::new().normal(g, sys.potential);
+        let written_g = g.gradient(potential, sys.q);
+        let (momentum, mass, gravity) = match tree {
+            Some(t) => t.add_to(g, sys, (momentum, mass, &written_g)),
+            None => (momentum, mass, written_g.clone()),
+        };
         // dm[i][j][k] = ∂M_ij/∂q_k, shared by C and ∂(M v)/∂q.
         let dm = mass_derivatives(g, sys, &mass);
-        let coriolis = coriolis(g, sys, &dm);
-        let potential = TrigForm::new().normal(g, sys.potential);
-        let gravity = g.gradient(potential, sys.q);
-        let forces = total_forces(g, sys, &coriolis, &gravity);
+        let coriolis = match tree {
+            Some(t) if !written_t => t.coriolis.clone(),
+            _ => coriolis(g, sys, &dm),
+        };
+        let forces = match tree {
+            // The tree's bias comes from the recursion; what the written
+            // `V` adds is its gradient alone.
+            Some(t) if !written_t => t.forces(g, sys, &written_g),
+            _ => total_forces(g, sys, &coriolis, &gravity),
+        };
         let jacobian = g.jacobian(sys.gaps, sys.q);
         let force_dq = g.jacobian(&forces, sys.q);
-        let force_dv = g.jacobian(&forces, sys.v);
+        let force_dv = match tree {
+            Some(t) if !written_t => t.forces_dv(g, sys, &coriolis),
+            _ => g.jacobian(&forces, sys.v),
+        };
         // ∂(M v)_i/∂q_j = Σ_k ∂M_ik/∂q_j v_k.
         let mass_dq = (0..n)
             .map(|i| (0..n).map(|j| contract(g, sys, &|k| dm[i][k][j])).collect())
