@@ -7,9 +7,10 @@
 //! target's baseline (x86-64 here), the C at `-O3` and the Rust at the
 //! bench profile's `opt-level = 3`.
 //!
-//! When Pinocchio's wheel is found (a venv in `MOREAU_PINOCCHIO_VENV`, or
-//! the `.venv-pinocchio` that `.ci/run` makes at the repository's root),
-//! also compiles `pinocchio/shim.cpp` against its headers at `-O3` (Eigen's
+//! When asked for with `MOREAU_PINOCCHIO_VENV` (a venv holding Pinocchio's
+//! wheel, such as the `.venv-pinocchio` that `.ci/run` makes at the
+//! repository's root; only on request, since the shim takes about 100 s to
+//! compile per build profile), also compiles `pinocchio/shim.cpp` against its headers at `-O3` (Eigen's
 //! headers from `/usr/include/eigen3`, Debian's `libeigen3-dev`), saves the
 //! benchmark's robots as Pinocchio archives into `OUT_DIR` with the venv's
 //! Python, and sets `cfg(pinocchio)` for the benchmark beside Pinocchio.
@@ -40,11 +41,16 @@ fn main() {
 /// The venv holding the `pin` wheel, if any.
 fn pinocchio_venv() -> Option<PathBuf> {
     println!("cargo:rerun-if-env-changed=MOREAU_PINOCCHIO_VENV");
-    let venv = match std::env::var_os("MOREAU_PINOCCHIO_VENV") {
-        Some(v) => PathBuf::from(v),
-        None => Path::new("../.venv-pinocchio").canonicalize().ok()?,
-    };
-    prefix(&venv).is_some().then_some(venv)
+    let venv = PathBuf::from(std::env::var_os("MOREAU_PINOCCHIO_VENV")?);
+    if prefix(&venv).is_none() {
+        println!(
+            "cargo:warning=MOREAU_PINOCCHIO_VENV={} holds no Pinocchio wheel \
+             (pip install -r tests/requirements-pinocchio.txt): the benchmark beside Pinocchio is left out",
+            venv.display()
+        );
+        return None;
+    }
+    Some(venv)
 }
 
 /// The wheel's install prefix (`cmeel.prefix`) in `venv`.

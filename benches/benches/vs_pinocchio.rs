@@ -21,9 +21,9 @@
 //! the minimum and median time per call of each side and the ratio
 //! Pinocchio / moreau of the medians.
 //!
-//! The benchmark is built only where `build.rs` found the wheel (a venv in
-//! `MOREAU_PINOCCHIO_VENV`, or `.venv-pinocchio` at the repository's root,
-//! as `.ci/run` makes it) and Eigen's headers:
+//! The benchmark is built only when `MOREAU_PINOCCHIO_VENV` names a venv
+//! with the wheel (`.venv-pinocchio` at the repository's root, as `.ci/run`
+//! makes it, will do) and Eigen's headers are installed:
 //!
 //! `MOREAU_PINOCCHIO_VENV=/path/to/venv cargo bench -p moreau-bench --bench vs_pinocchio`
 
