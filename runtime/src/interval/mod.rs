@@ -449,7 +449,7 @@ impl Mul for Interval {
     /// The product by the sign cases of the operands: only the corners that
     /// can hold the smallest and the largest product are rounded (two
     /// TwoProducts unless both operands straddle zero), each down or up as
-    /// [`mul_down`] and [`mul_up`] would.
+    /// `mul_down` and `mul_up` would.
     #[inline]
     fn mul(self, o: Self) -> Self {
         let (a, b, c, d) = (self.lo, self.hi, o.lo, o.hi);
