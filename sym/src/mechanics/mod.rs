@@ -394,8 +394,7 @@ fn mass_matrix(
     let n = sys.q.len();
     let zero = g.constant(0.0);
     let momentum = g.gradient(sys.kinetic, sys.v);
-    let mut trig = TrigForm::new();
-    let mut mass = vec![vec![zero; n]; n];
+    let mut raw = Vec::new();
     for (i, &p) in momentum.iter().enumerate() {
         for j in i..n {
             let m = g.diff(p, sys.v[j]);
@@ -406,10 +405,15 @@ fn mass_matrix(
                     velocity: k,
                 });
             }
-            let m = trig.normal(g, m);
-            mass[i][j] = m;
-            mass[j][i] = m;
+            raw.push((i, j, m));
         }
+    }
+    let entries: Vec<Id> = raw.iter().map(|&(_, _, m)| m).collect();
+    let normal = TrigForm::new().normal_all(g, &entries);
+    let mut mass = vec![vec![zero; n]; n];
+    for (&(i, j, _), m) in raw.iter().zip(normal) {
+        mass[i][j] = m;
+        mass[j][i] = m;
     }
     Ok((momentum, mass))
 }
