@@ -265,3 +265,96 @@ fn energies_written_beside_a_tree_add_to_it() {
         }
     }
 }
+
+moreau::model! {
+    /// `TwoLinkInline`'s tree with its `tip`'s orientation read through
+    /// the gaps: the world components of the directions `[0.6, 0, 0.8]`
+    /// and `[0, 1, 0]` fixed in the tip, and of the tip's point at
+    /// `[0.6, 0, 0.8]` less its origin (each gap is the value plus 2).
+    pub struct TwoLinkOriented;
+    parameters { m1: 1.5, m2: 0.7, l1: 0.9, l2: 0.6, g: 9.81 }
+    gravity = [0, 0, -g];
+    bodies {
+        upper: {
+            parent: world,
+            joint: revolute(a1: w1),
+            axis: [0, -1, 0],
+            xyz: [0, 0, 0.3],
+            mass: m1,
+            com: [0, 0, -l1 / 2],
+            inertia: [m1 * l1^2 / 12, 0, 0, m1 * l1^2 / 12, 0, 0],
+        },
+        lower: {
+            parent: upper,
+            joint: revolute(a2),
+            axis: [0, -2, 0],
+            xyz: [0, 0, -l1],
+            mass: m2,
+            com: [0, 0, -l2 / 2],
+            inertia: [m2 * l2^2 / 12, 0, 0, m2 * l2^2 / 12, 0, 0],
+        },
+        tip: { parent: lower, joint: fixed, xyz: [0, 0, -l2], rpy: [0.3, -0.2, 1.1], mass: 0.25 },
+    }
+    constraints {
+        ux: direction_x(tip, 0.6, 0, 0.8) + 2 >= 0,
+        uy: direction_y(tip, 0.6, 0, 0.8) + 2 >= 0,
+        uz: direction_z(tip, 0.6, 0, 0.8) + 2 >= 0,
+        wx: direction_x(tip, 0, 1, 0) + 2 >= 0,
+        wy: direction_y(tip, 0, 1, 0) + 2 >= 0,
+        wz: direction_z(tip, 0, 1, 0) + 2 >= 0,
+        px: position_x(tip, 0.6, 0, 0.8) - position_x(tip) + 2 >= 0,
+        py: position_y(tip, 0.6, 0, 0.8) - position_y(tip) + 2 >= 0,
+        pz: position_z(tip, 0.6, 0, 0.8) - position_z(tip) + 2 >= 0,
+    }
+    restitution = 0.5;
+}
+
+/// `direction_x/_y/_z(body, x, y, z)` is the body's rotation applied to
+/// `[x, y, z]`: against the rotation written by hand (the tip turns about
+/// `−y` by `a1 + a2`, the joints' axes normalised as URDF does, then by its
+/// roll-pitch-yaw), to 1e-12; the directions keep their lengths and their
+/// right angle; a point's offset from its body's origin is its direction;
+/// and the generated Jacobian of each is its derivative (central
+/// differences, 1e-7).
+#[test]
+fn directions_are_the_bodys_rotation() {
+    use nalgebra::{Rotation3, Vector3};
+    let model = TwoLinkOriented::<f64>::new();
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    for _ in 0..20 {
+        let q = Vector2::new(3.0 * uniform(&mut seed), 3.0 * uniform(&mut seed));
+        let h = model.gaps(&q).add_scalar(-2.0);
+        let (u, w, p) = (
+            Vector3::new(h[0], h[1], h[2]),
+            Vector3::new(h[3], h[4], h[5]),
+            Vector3::new(h[6], h[7], h[8]),
+        );
+        let rotation = Rotation3::from_axis_angle(&Vector3::y_axis(), -(q[0] + q[1]))
+            * Rotation3::from_euler_angles(0.3, -0.2, 1.1);
+        let (u_hand, w_hand) = (
+            rotation * Vector3::new(0.6, 0.0, 0.8),
+            rotation * Vector3::new(0.0, 1.0, 0.0),
+        );
+        for i in 0..3 {
+            close(u[i], u_hand[i], "direction [0.6, 0, 0.8]");
+            close(w[i], w_hand[i], "direction [0, 1, 0]");
+            close(p[i], u[i], "point offset against direction");
+        }
+        close(u.norm(), 1.0, "|R u|");
+        close(w.norm(), 1.0, "|R w|");
+        close(u.dot(&w), 0.0, "R u · R w");
+        let jac = model.gap_jacobian(&q);
+        for k in 0..2 {
+            let dq = Vector2::from_fn(|i, _| if i == k { 1e-6 } else { 0.0 });
+            let fd = (model.gaps(&(q + dq)) - model.gaps(&(q - dq))) / 2e-6;
+            for i in 0..9 {
+                assert!(
+                    (jac[(i, k)] - fd[i]).abs() < 1e-7,
+                    "J[{i}, {k}] {} against {}",
+                    jac[(i, k)],
+                    fd[i]
+                );
+            }
+        }
+    }
+}

@@ -10,7 +10,7 @@
 use std::collections::HashSet;
 
 use crate::ctxt::Ctxt;
-use crate::expr::{Expr, ExprKind, POSITION_FUNCTIONS};
+use crate::expr::{Expr, ExprKind};
 use crate::keys;
 use crate::loc::Loc;
 use crate::scope::{Scope, Symbol, Var};
@@ -499,12 +499,12 @@ fn check_body_references(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
                 walk(cx, scope, a);
                 walk(cx, scope, b);
             }
-            ExprKind::Position(axis, body, point) => {
+            ExprKind::Frame(kind, axis, body, point) => {
                 match scope.get(body) {
                     Some(Symbol::Body(_)) | None => {}
                     Some(_) => cx.error(
                         e.loc,
-                        format!("`{body}` is not a body: the first argument of `{}` names a body of `{}`", POSITION_FUNCTIONS[*axis], keys::BODIES),
+                        format!("`{body}` is not a body: the first argument of `{}` names a body of `{}`", kind.functions()[*axis], keys::BODIES),
                     ),
                 }
                 point.iter().for_each(|c| walk(cx, scope, c));

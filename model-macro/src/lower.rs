@@ -10,7 +10,7 @@ use moreau_sym::{
 };
 
 use crate::ctxt::Ctxt;
-use crate::expr::{BinOp, Expr, ExprKind};
+use crate::expr::{BinOp, Expr, ExprKind, Fixed};
 use crate::loc::Loc;
 use crate::resolve::{Resolved, VarLayout};
 use crate::scope::{Symbol, Var};
@@ -278,13 +278,16 @@ impl Builder<'_> {
             ExprKind::Name(Symbol::Pi) => g.constant(std::f64::consts::PI),
             // The checks report a body named outside `position_x`.
             ExprKind::Name(Symbol::Body(_)) => return None,
-            ExprKind::Position(axis, Symbol::Body(i), point) => {
+            ExprKind::Frame(kind, axis, Symbol::Body(i), point) => {
                 let pose = self.poses[*i]?;
                 let local = self.three(point)?;
-                tree::point(&mut self.graph, &pose, local)[*axis]
+                match kind {
+                    Fixed::Point => tree::point(&mut self.graph, &pose, local)[*axis],
+                    Fixed::Direction => tree::direction(&mut self.graph, &pose, local)[*axis],
+                }
             }
             // The checks report a `position_x` of something not a body.
-            ExprKind::Position(..) => return None,
+            ExprKind::Frame(..) => return None,
             ExprKind::Neg(a) => {
                 let a = self.expr(a)?;
                 self.graph.neg(a)

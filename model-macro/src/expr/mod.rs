@@ -8,9 +8,14 @@
 //! atom  := number | name | name '(' expr (',' expr)* ')' | '(' expr ')'
 //! ```
 //!
-//! Two calls are not elementary functions: `position_x(body, x, y, z)`
-//! (and `_y`, `_z`) is a world coordinate of the point `[x, y, z]` of a
-//! body's frame, and `position_x(body)` that of the frame's origin.
+//! Two families of calls are not elementary functions: `position_x(body, x,
+//! y, z)` (and `_y`, `_z`) is a world coordinate of the point `[x, y, z]` of
+//! a body's frame, and `position_x(body)` that of the frame's origin;
+//! `direction_x(body, x, y, z)` (and `_y`, `_z`) is a world coordinate of
+//! the direction `[x, y, z]` fixed in the body's frame, rotated and not
+//! moved: the body's orientation (`direction_z(hand, 0, 0, 1)` is the
+//! vertical component of the hand's `z` axis, the entry `R_zz` of its
+//! rotation).
 //!
 //! This is the grammar's one statement; `models/README.md` and the CasADi
 //! reference parser (`tests/casadi_reference.py`) point here. The functions
@@ -90,15 +95,42 @@ pub(crate) enum ExprKind<N> {
     Func(Func, Box<Expr<N>>),
     /// `atan2(y, x)`.
     Atan2(Box<Expr<N>>, Box<Expr<N>>),
-    /// One world coordinate (0: x, 1: y, 2: z) of a point fixed in a body,
-    /// given in the body's frame: `position_z(hand, 0, 0, 0.1)`. The body is
-    /// a name like any other (bodies share the one namespace); resolution
+    /// One world coordinate (0: x, 1: y, 2: z) of a point or a direction
+    /// fixed in a body, given in the body's frame:
+    /// `position_z(hand, 0, 0, 0.1)`, `direction_z(hand, 0, 0, 1)`. The body
+    /// is a name like any other (bodies share the one namespace); resolution
     /// checks that it names a body.
-    Position(usize, N, Box<[Expr<N>; 3]>),
+    Frame(Fixed, usize, N, Box<[Expr<N>; 3]>),
 }
 
-/// The functions that give a point's world position, by axis.
-pub(crate) const POSITION_FUNCTIONS: [&str; 3] = ["position_x", "position_y", "position_z"];
+/// What a body-frame call maps to the world.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Fixed {
+    /// A point: rotated and moved with the body (`position_x`).
+    Point,
+    /// A direction: rotated with the body, not moved (`direction_x`).
+    Direction,
+}
+
+impl Fixed {
+    /// The calls of this kind, by axis.
+    pub fn functions(self) -> [&'static str; 3] {
+        match self {
+            Fixed::Point => ["position_x", "position_y", "position_z"],
+            Fixed::Direction => ["direction_x", "direction_y", "direction_z"],
+        }
+    }
+
+    /// The kind and axis of a call's name, if it is one.
+    pub fn of(name: &str) -> Option<(Fixed, usize)> {
+        [Fixed::Point, Fixed::Direction]
+            .into_iter()
+            .find_map(|kind| {
+                let axis = kind.functions().iter().position(|f| *f == name)?;
+                Some((kind, axis))
+            })
+    }
+}
 
 impl<N> Expr<N> {
     /// Calls `f` on every name this expression uses, in reading order.
@@ -111,7 +143,7 @@ impl<N> Expr<N> {
                 a.visit(f);
                 b.visit(f);
             }
-            ExprKind::Position(_, body, point) => {
+            ExprKind::Frame(_, _, body, point) => {
                 f(body, self.loc);
                 point.iter().for_each(|c| c.visit(f));
             }
@@ -135,11 +167,11 @@ impl<N> Expr<N> {
                 let (a, b) = (a.try_map(f), b.try_map(f));
                 ExprKind::Atan2(Box::new(a?), Box::new(b?))
             }
-            ExprKind::Position(axis, body, point) => {
+            ExprKind::Frame(kind, axis, body, point) => {
                 let body = f(body, self.loc);
                 let [x, y, z] = &**point;
                 let (x, y, z) = (x.try_map(f), y.try_map(f), z.try_map(f));
-                ExprKind::Position(*axis, body?, Box::new([x?, y?, z?]))
+                ExprKind::Frame(*kind, *axis, body?, Box::new([x?, y?, z?]))
             }
         };
         Some(Expr {
@@ -184,10 +216,13 @@ impl fmt::Display for Expr {
             }
             ExprKind::Func(func, a) => write!(f, "{func}({a})"),
             ExprKind::Atan2(y, x) => write!(f, "atan2({y}, {x})"),
-            ExprKind::Position(axis, body, p) => write!(
+            ExprKind::Frame(kind, axis, body, p) => write!(
                 f,
                 "{}({body}, {}, {}, {})",
-                POSITION_FUNCTIONS[*axis], p[0], p[1], p[2]
+                kind.functions()[*axis],
+                p[0],
+                p[1],
+                p[2]
             ),
         }
     }

@@ -194,8 +194,8 @@ impl Parser<'_> {
             args.push(self.expr()?);
         }
         self.close(loc)?;
-        if let Some(axis) = super::POSITION_FUNCTIONS.iter().position(|f| *f == name) {
-            return self.position(axis, &name, args, loc);
+        if let Some((kind, axis)) = super::Fixed::of(&name) {
+            return self.frame(kind, axis, &name, args, loc);
         }
         let Some(func) = func else {
             let names: Vec<&str> = Function::ALL.iter().map(|f| f.name()).collect();
@@ -226,8 +226,16 @@ impl Parser<'_> {
         Some(Expr { kind, loc })
     }
 
-    /// `position_x(body)` or `position_x(body, x, y, z)`.
-    fn position(&mut self, axis: usize, name: &str, args: Vec<Expr>, loc: Loc) -> Option<Expr> {
+    /// `position_x(body)`, `position_x(body, x, y, z)` or
+    /// `direction_x(body, x, y, z)` (a direction has no default).
+    fn frame(
+        &mut self,
+        kind: super::Fixed,
+        axis: usize,
+        name: &str,
+        args: Vec<Expr>,
+        loc: Loc,
+    ) -> Option<Expr> {
         let zero = || Expr {
             kind: ExprKind::Num(0.0),
             loc,
@@ -235,13 +243,20 @@ impl Parser<'_> {
         let mut args = args.into_iter();
         let body = args.next()?;
         let point: Vec<Expr> = args.collect();
-        let point = match point.len() {
-            0 => [zero(), zero(), zero()],
-            3 => <[Expr; 3]>::try_from(point).ok()?,
-            found => {
+        let point = match (point.len(), kind) {
+            (0, super::Fixed::Point) => [zero(), zero(), zero()],
+            (3, _) => <[Expr; 3]>::try_from(point).ok()?,
+            (found, super::Fixed::Point) => {
                 self.cx.error(
                     loc,
                     format!("`{name}` takes a body and, optionally, the point's three coordinates in the body's frame (`{name}(body, x, y, z)`); found {} argument{}", found + 1, if found == 0 { "" } else { "s" }),
+                );
+                return None;
+            }
+            (found, super::Fixed::Direction) => {
+                self.cx.error(
+                    loc,
+                    format!("`{name}` takes a body and the direction's three coordinates in the body's frame (`{name}(body, x, y, z)`); found {} argument{}", found + 1, if found == 0 { "" } else { "s" }),
                 );
                 return None;
             }
@@ -254,7 +269,7 @@ impl Parser<'_> {
             return None;
         };
         Some(Expr {
-            kind: ExprKind::Position(axis, body_name, Box::new(point)),
+            kind: ExprKind::Frame(kind, axis, body_name, Box::new(point)),
             loc,
         })
     }

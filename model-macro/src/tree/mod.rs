@@ -134,8 +134,14 @@ fn place(
 
 /// The world position of the point `local` of a body at `pose`.
 pub(crate) fn point(g: &mut Graph, pose: &Pose, local: V3) -> V3 {
-    let arm = mat_vec(g, &pose.r, local);
+    let arm = direction(g, pose, local);
     add(g, pose.p, arm)
+}
+
+/// The world components of the direction `local` fixed in a body of pose
+/// `pose`: `R local` (`direction_x(body, x, y, z)` and `_y`, `_z`).
+pub(crate) fn direction(g: &mut Graph, pose: &Pose, local: V3) -> V3 {
+    mat_vec(g, &pose.r, local)
 }
 
 /// `Rz(yaw) Ry(pitch) Rx(roll)`.
