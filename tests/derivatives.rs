@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{casadi_fixture, matrix, min_eigenvalue, relative_error, vector};
+use common::{casadi_fixture, central, matrix, min_eigenvalue, relative_error, vector};
 use moreau::{Model, Sensitivities};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector};
@@ -178,21 +178,6 @@ fn defaults_match_the_model_files() {
     defaults::<Billiard, 2, 4, 0>("billiard");
     defaults::<DoublePendulum, 2, 2, 0>("double_pendulum");
     defaults::<Arm3, 3, 1, 3>("arm3");
-}
-
-/// Central difference of `f` at `x` along coordinate `j`, with a step
-/// relative to the magnitude of `x_j`.
-fn central<const N: usize, const R: usize>(
-    f: impl Fn(&SVector<f64, N>) -> SVector<f64, R>,
-    x: &SVector<f64, N>,
-    j: usize,
-) -> SVector<f64, R> {
-    let step = 1e-6 * x[j].abs().max(1.0);
-    let mut plus = *x;
-    let mut minus = *x;
-    plus[j] += step;
-    minus[j] -= step;
-    (f(&plus) - f(&minus)) / (2.0 * step)
 }
 
 /// What needs no CasADi, at the fixture's points: M symmetric positive

@@ -15,6 +15,8 @@
 
 mod common;
 
+use common::central;
+
 use moreau::{Model, Sensitivities};
 use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
@@ -205,20 +207,6 @@ fn coordinates_are_the_urdf_joints_with_generated_velocities() {
     assert_eq!(info.coordinates[0], "shoulder_pan_joint");
     assert_eq!(info.velocities[0], "dshoulder_pan_joint");
     assert_eq!(Panda::<f64>::INFO.constraints[2], "table");
-}
-
-/// Central difference of `f` at `x` along coordinate `j` (step 1e-6
-/// relative to `x_j`).
-fn central<const N: usize, const R: usize>(
-    f: impl Fn(&SVector<f64, N>) -> SVector<f64, R>,
-    x: &SVector<f64, N>,
-    j: usize,
-) -> SVector<f64, R> {
-    let step = 1e-6 * x[j].abs().max(1.0);
-    let (mut plus, mut minus) = (*x, *x);
-    plus[j] += step;
-    minus[j] -= step;
-    (f(&plus) - f(&minus)) / (2.0 * step)
 }
 
 /// The derivatives the graph builds from the recursions (`∂F/∂q`, `∂F/∂v`,

@@ -71,3 +71,17 @@ pub fn min_eigenvalue<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
     let d = DMatrix::from_iterator(N, N, m.iter().copied());
     d.symmetric_eigenvalues().min()
 }
+
+/// Central difference of `f` at `x` along coordinate `j`, with the step
+/// `1e-6 max(|x_j|, 1)`.
+pub fn central<const N: usize, const R: usize>(
+    f: impl Fn(&SVector<f64, N>) -> SVector<f64, R>,
+    x: &SVector<f64, N>,
+    j: usize,
+) -> SVector<f64, R> {
+    let step = 1e-6 * x[j].abs().max(1.0);
+    let (mut plus, mut minus) = (*x, *x);
+    plus[j] += step;
+    minus[j] -= step;
+    (f(&plus) - f(&minus)) / (2.0 * step)
+}
