@@ -2,11 +2,12 @@
 //! reduced-order observer (38), in one run, on Example 1 sampled at 1 kHz
 //! with σ = 1e-4: in free flight, with an impact inside the interval, and
 //! sliding. Each estimator is first run over the record up to the
-//! interval, so it starts from its own converged state.
+//! interval, so it starts from its own converged state; the copy of it
+//! that each timed update starts from is made outside the timed region.
 //!
 //! `cargo bench -p moreau-bench --bench kalman`
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use moreau::{
     KalmanParams, MoreauJean, Observer, ObserverParams, ReducedOrder, SaltationKalman, State,
     StepParams,
@@ -83,17 +84,21 @@ fn updates(c: &mut Criterion) {
             probe.kalman_report().saltations,
             probe.report().contacts
         );
+        // the estimator as it was before the update is copied outside the
+        // timed region: a user updates in place and never copies it
         group.bench_function(format!("saltation Kalman, {label}"), |b| {
-            b.iter(|| {
-                let mut f = black_box(kalman);
-                f.update(&model, t, &q, &u).unwrap()
-            })
+            b.iter_batched_ref(
+                || kalman,
+                |f| f.update(&model, black_box(t), &q, &u).unwrap(),
+                BatchSize::SmallInput,
+            )
         });
         group.bench_function(format!("reduced (38), {label}"), |b| {
-            b.iter(|| {
-                let mut o = black_box(reduced);
-                o.update(&model, t, &q, &u).unwrap()
-            })
+            b.iter_batched_ref(
+                || reduced,
+                |o| o.update(&model, black_box(t), &q, &u).unwrap(),
+                BatchSize::SmallInput,
+            )
         });
     }
     group.finish();
