@@ -196,10 +196,12 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     /// knob [`tune_process_noise`] turns).
     #[must_use]
     pub fn scaled(self, factor: T) -> Self {
-        Self {
-            accel_noise: self.accel_noise * factor,
-            ..self
-        }
+        self.scaled_by(&NoiseFactors {
+            accel: factor,
+            impact: T::one(),
+            impact_time: T::one(),
+            contact: T::one(),
+        })
     }
 
     /// The same settings with each process-noise knob scaled by its
