@@ -140,6 +140,42 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     pub contact_noise: T,
 }
 
+/// The Cholesky factor of the innovation covariance `S = P_qq + R + δ I`
+/// and the `R + δ I` it used, `δ` starting at `floor` (the rounding of the
+/// samples and of `P`).
+///
+/// With exact samples (`R = 0`) and `P` held on a contact manifold (its
+/// normal variance zero up to rounding), `P_qq` can come out of the
+/// propagation with an eigenvalue a few roundings below zero, more than a
+/// floor set by `P_qq`'s own size covers; `δ` then grows a hundredfold at
+/// a time (at most six times) until `S` factors, as a Gaussian-process
+/// code adds jitter. Only a covariance that is not positive definite by
+/// more than rounding is an error.
+fn innovation_factor<T: RealField + Copy, const N: usize>(
+    p_qq: &SMatrix<T, N, N>,
+    measurement: &SMatrix<T, N, N>,
+    floor: T,
+) -> Result<
+    (
+        SMatrix<T, N, N>,
+        nalgebra::linalg::Cholesky<T, nalgebra::Const<N>>,
+    ),
+    T,
+> {
+    let mut delta = floor;
+    for _ in 0..7 {
+        let r = measurement + SMatrix::<T, N, N>::identity() * delta;
+        if let Some(chol) = nalgebra::linalg::Cholesky::new(p_qq + r) {
+            return Ok((r, chol));
+        }
+        delta *= nalgebra::convert(100.0);
+    }
+    Err(ObserverError::Data(DataError::InvalidParams {
+        name: "measurement",
+        value: measurement.trace(),
+    }))
+}
+
 /// `χ²_N` quantile `z` standard deviations out, by Wilson–Hilferty:
 /// `N (1 − 2/(9N) + z √(2/(9N)))³`.
 fn chi_square_quantile<T: RealField + Copy>(n: usize, z: T) -> T {
@@ -599,17 +635,9 @@ where
         // covariance itself (64 ε its largest variance), so that exact
         // samples (R = 0) never leave S singular
         let eps = T::default_epsilon();
-        let rounding = eps * q.amax().max(T::one());
-        let floor = rounding * rounding + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax();
-        let r = self.params.measurement + SMatrix::<T, N, N>::identity() * floor;
-        let not_pd = || {
-            ObserverError::Data(DataError::InvalidParams {
-                name: "measurement",
-                value: r.trace(),
-            })
-        };
-        let mut s = p.qq + r;
-        let mut chol = nalgebra::linalg::Cholesky::new(s).ok_or_else(not_pd)?;
+        let scale = q.amax().max(T::one());
+        let floor = eps * scale * scale + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax();
+        let (mut r, mut chol) = innovation_factor(&p.qq, &self.params.measurement, floor)?;
         let mut nis = y.dot(&chol.solve(&y));
         let mut outliers = self.outliers;
         let gate = self.params.gate;
@@ -617,8 +645,7 @@ where
             // the model, not the sample, is wrong: widen the prediction
             p = p.scaled(nis / nalgebra::convert(N.max(1) as f64));
             kalman.inflated = true;
-            s = p.qq + r;
-            chol = nalgebra::linalg::Cholesky::new(s).ok_or_else(not_pd)?;
+            (r, chol) = innovation_factor(&p.qq, &self.params.measurement, floor)?;
             nis = y.dot(&chol.solve(&y));
         }
         kalman.nis = nis;
