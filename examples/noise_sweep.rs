@@ -11,9 +11,11 @@
 //! samples, the reduced-order observer (38), the full-order observer (36)
 //! and the saltation Kalman filter, on Example 1 from three initial states
 //! (the model file's accumulates at 4.456 s and then slides), the three
-//! balls and the double pendulum. The filter's process noise is picked once
-//! per system by `tune_process_noise` from a run with σ = 1e-4 and its
-//! own noise seed (its first 3 s); every σ adds its own noise to one plant run.
+//! balls and the double pendulum. The filter runs twice: with its default
+//! process noise (`KalmanParams::new`), and with the process noise picked
+//! once per system by `tune_process_noise` from a run with σ = 1e-4 and
+//! its own noise seed (its first 3 s); every σ adds its own noise to one
+//! plant run.
 //!
 //! `cargo run --release --example noise_sweep`
 
@@ -25,7 +27,7 @@ use moreau::{
 };
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2};
-use plotters::style::full_palette::{BLUE_700, GREEN_700, ORANGE_800, RED_600};
+use plotters::style::full_palette::{BLUE_700, GREEN_700, ORANGE_800, PURPLE_700, RED_600};
 use support::observe::{quantile, run, window};
 use support::plot::{Panel, Result, Series, announce, csv, figure};
 use support::reference::{Gaussian, Reference};
@@ -139,11 +141,12 @@ fn main() -> Result<()> {
 }
 
 /// The estimators of the side-by-side tables, in their columns' order.
-const ESTIMATORS: [&str; 4] = [
+const ESTIMATORS: [&str; 5] = [
     "finite differences",
     "reduced (38)",
     "full (36)",
-    "saltation Kalman",
+    "Kalman, defaults",
+    "Kalman, tuned",
 ];
 
 /// Median `|v − v̂|` over `[2, T_END]` s of each estimator on the same noisy
@@ -215,7 +218,7 @@ where
         row.extend(medians);
         rows.push(row);
     }
-    let colors = [RED_600, ORANGE_800, GREEN_700, BLUE_700];
+    let colors = [RED_600, ORANGE_800, GREEN_700, PURPLE_700, BLUE_700];
     let series = ESTIMATORS
         .iter()
         .enumerate()
@@ -236,7 +239,8 @@ where
         "finite_differences",
         "reduced_38",
         "full_36",
-        "saltation_kalman",
+        "saltation_kalman_defaults",
+        "saltation_kalman_tuned",
     ];
     let data = csv(&stem, &header, rows)?;
     announce(&[&png, &svg, &data]);
@@ -250,7 +254,7 @@ fn estimate_all<M, const N: usize, const K: usize>(
     sigma: f64,
     velocity_bound: f64,
     knobs: &KalmanParams<f64, N>,
-) -> Result<[f64; 4]>
+) -> Result<[f64; 5]>
 where
     M: Sensitivities<N, K, Scalar = f64, Input = SVector<f64, 0>>,
 {
@@ -272,8 +276,10 @@ where
     let gains = FullOrderGains::scalar(5.0, 25.0);
     let mut full = FullOrder::<f64, N, K>::new(params, gains, t[0], q[0], SVector::zeros())?;
     let full = run::<_, _, N, K, 0>(model, &mut full, reference)?.v;
-    // the tuned process noise, told this run's σ
-    let kalman_params = KalmanParams {
+    // the filter with its default process noise, and with the tuned one,
+    // each told this run's σ
+    let defaults = KalmanParams::new(velocity_bound, sigma);
+    let tuned = KalmanParams {
         observer: ObserverParams {
             noise: sigma,
             ..knobs.observer
@@ -281,8 +287,16 @@ where
         measurement: SMatrix::identity() * (sigma * sigma),
         ..*knobs
     };
-    let mut filter =
-        SaltationKalman::<f64, N, K>::new(kalman_params, t[0], q[0], SVector::zeros())?;
-    let kalman = run::<_, _, N, K, 0>(model, &mut filter, reference)?.v;
-    Ok([score(&fd), score(&reduced), score(&full), score(&kalman)])
+    let mut kalman = [0.0; 2];
+    for (median, params) in kalman.iter_mut().zip([defaults, tuned]) {
+        let mut filter = SaltationKalman::<f64, N, K>::new(params, t[0], q[0], SVector::zeros())?;
+        *median = score(&run::<_, _, N, K, 0>(model, &mut filter, reference)?.v);
+    }
+    Ok([
+        score(&fd),
+        score(&reduced),
+        score(&full),
+        kalman[0],
+        kalman[1],
+    ])
 }

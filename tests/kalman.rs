@@ -570,26 +570,37 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
 
 /// Example 1 on four initial states (the model file's, whose impacts
 /// accumulate at 4.456 s before it slides, and three more), `v̂(0) = 0`,
-/// 1 kHz samples of the plant at `τ = 1e-5`, scored over `[2, 10]` s; the
-/// four process-noise knobs picked once by the likelihood helper from
-/// another noisy run (the model file's start, its own noise seed).
+/// 1 kHz samples of the plant at `τ = 1e-5`, scored over `[2, 10]` s;
+/// the filter with its default process noise, and with the four knobs
+/// picked once by the likelihood helper from another noisy run (the model
+/// file's start, its own noise seed).
 ///
 /// Asserted: with exact samples the median is at most 1e-8 (the issue's
 /// figure); with `σ = 1e-4` the median is at most 1e-4 and the 90th
 /// percentile at most 4e-4 (the hand-written Python saltation filter the
 /// issue measured on such data: median 5e-5 to 1e-4, 90th percentile 2e-4
-/// to 7e-4), and the median at least ten times below that of the
+/// to 7e-4), with the defaults the median below that filter's best
+/// (5e-5), and the median at least ten times below that of the
 /// reduced-order observer (38), told `σ`, on the same samples. The
 /// issue's own targets (median ≤ 3e-5, 90th percentile ≤ 2e-4, maximum
 /// ≤ 1e-2 off the bracketing samples) are printed, not asserted: they are
-/// met on some starts only (the plant's own impacts deviate from the
-/// exact law by up to 4e-3 m/s at τ = 1e-5; see the note of issue 10).
+/// met on some starts only (the plant places each impact somewhere in its
+/// 10 µs step, and micro-bounces in an accumulation rise below σ; see the
+/// README).
 #[test]
 fn example_1_figures_beside_the_reduced_order_observer() {
     let model = Parabola::<f64>::new();
     let u = SVector::zeros();
-    let params = tuned_example_1(1e-4);
-    for (n, start) in example_1_starts().into_iter().enumerate() {
+    let tuned = tuned_example_1(1e-4);
+    let knobs = [
+        ("defaults", KalmanParams::new(20.0, 1e-4)),
+        ("tuned", tuned),
+    ];
+    for ((n, start), (label, params)) in example_1_starts()
+        .into_iter()
+        .enumerate()
+        .flat_map(|s| knobs.map(|k| (s, k)))
+    {
         let data = reference(&model, start, 1e-5, 100, 10.0, &u);
         for sigma in [1e-4, 0.0] {
             let measured = measure(&data, sigma, 11 + n as u64);
@@ -616,7 +627,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
             let obs = run(&mut o, &model, &data, &measured, &u);
             let so = score(&data, &obs, (2.0, 10.0 + 1e-3));
             eprintln!(
-                "Example 1, start {n}, σ = {sigma:e}: filter median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e}; samples to recover, worst {}), (38) median {:.2e} p90 {:.2e} max {:.2e}",
+                "Example 1, start {n}, σ = {sigma:e}, knobs {label}: filter median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e}; samples to recover, worst {}), (38) median {:.2e} p90 {:.2e} max {:.2e}",
                 sc.all.median,
                 sc.all.p90,
                 sc.all.max,
@@ -631,15 +642,22 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 sc.recover
             );
             if sigma == 0.0 {
-                assert!(sc.all.median <= 1e-8, "start {n}: {:e}", sc.all.median);
+                assert!(
+                    sc.all.median <= 1e-8,
+                    "start {n}, {label}: {:e}",
+                    sc.all.median
+                );
             } else {
                 assert!(
                     sc.all.median <= 1e-4 && sc.all.p90 <= 4e-4,
-                    "start {n}: median {:e}, p90 {:e}",
+                    "start {n}, {label}: median {:e}, p90 {:e}",
                     sc.all.median,
                     sc.all.p90
                 );
-                assert!(sc.all.median * 10.0 <= so.all.median, "start {n}");
+                assert!(sc.all.median * 10.0 <= so.all.median, "start {n}, {label}");
+                if label == "defaults" {
+                    assert!(sc.all.median <= 5e-5, "start {n}: {:e}", sc.all.median);
+                }
             }
         }
     }
