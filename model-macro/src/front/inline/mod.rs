@@ -46,22 +46,7 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         .iter()
         .position(|t| is_punct(t, ';'))
         .map_or(trees.len(), |i| i + 1);
-    let header: TokenStream = trees[..header_end].iter().cloned().collect();
-    let header: Header = match syn::parse2(header) {
-        Ok(h) => h,
-        Err(e) => {
-            let message = match trees.as_slice() {
-                [TokenTree::Ident(k), eq, ..] if k == keys::URDF && is_punct(eq, '=') => {
-                    "an inline model starts with its name, then names its URDF: `pub struct Robot; urdf = \"path/to/robot.urdf\"; ...`".to_string()
-                }
-                _ => format!(
-                    "{e}; an inline model starts with `pub struct Name;` (or `model!(file = \"...\")` for a YAML file)"
-                ),
-            };
-            cx.error(Loc::span(e.span()), message);
-            return None;
-        }
-    };
+    let header = header(cx, &trees, header_end)?;
     let mut spec = ModelSpec {
         name: Name {
             text: header.ident.to_string(),
@@ -112,6 +97,27 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         }
     }
     Some(spec)
+}
+
+/// Reads `/// docs pub struct Name;`, the first `end` trees; `None` after
+/// reporting what is wrong.
+fn header(cx: &Ctxt, trees: &[TokenTree], end: usize) -> Option<Header> {
+    let header: TokenStream = trees[..end].iter().cloned().collect();
+    match syn::parse2(header) {
+        Ok(h) => Some(h),
+        Err(e) => {
+            let message = match trees {
+                [TokenTree::Ident(k), eq, ..] if k == keys::URDF && is_punct(eq, '=') => {
+                    "an inline model starts with its name, then names its URDF: `pub struct Robot; urdf = \"path/to/robot.urdf\"; ...`".to_string()
+                }
+                _ => format!(
+                    "{e}; an inline model starts with `pub struct Name;` (or `model!(file = \"...\")` for a YAML file)"
+                ),
+            };
+            cx.error(Loc::span(e.span()), message);
+            None
+        }
+    }
 }
 
 struct Header {
