@@ -38,6 +38,9 @@
 //! assert_eq!(terms.forces, Vector2::new(0.0, 9.81));
 //! ```
 //!
+//! A robot is a URDF named beside its contacts and restitution
+//! (`urdf = "path/to/robot.urdf";`): see [`model!`].
+//!
 //! An observer estimates the velocity from measured positions alone, through
 //! the impacts (the paper's reduced-order observer (38), with a gain chosen
 //! for a guaranteed decay rate by Corollary 3):
@@ -76,6 +79,47 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
+/// Compiles a mechanical model into a type implementing [`Model`],
+/// [`Sensitivities`] and [`Enclosure`]: from a YAML file
+/// (`model!(file = "models/parabola.yaml")`, the path relative to the
+/// crate's directory) or written inline (`model! { pub struct Name; ... }`,
+/// see the [crate] documentation). The language is described in
+/// `models/README.md`.
+///
+/// A robot is a URDF named beside its contacts, in YAML (`urdf:`, `locked:`,
+/// `limits:`) or inline, in a few lines:
+///
+/// ```
+/// moreau::model! {
+///     /// A UR5 whose tool may strike a table 20 cm below its base.
+///     pub struct Ur5;
+///     urdf = "tests/robots/urdf/ur_description/ur5_robot.urdf";
+///     constraints { table: position_z(tool0, 0, 0, 0.05) >= -0.2 }
+///     restitution = 0.3;
+/// }
+///
+/// use moreau::Model;
+/// use nalgebra::SVector;
+///
+/// // the coordinates are the URDF's moving joints, the velocities `d<joint>`
+/// assert_eq!(Ur5::<f64>::INFO.coordinates[0], "shoulder_pan_joint");
+/// assert_eq!(Ur5::<f64>::INFO.velocities[5], "dwrist_3_joint");
+/// let model = Ur5::<f64>::new();
+/// let q = SVector::<f64, 6>::zeros();
+/// // At q = 0 the arm lies along x: the flange's height is the shoulder's
+/// // 0.089159 m less the wrist's 0.09465 m (the point 5 cm out along the
+/// // tool's z is horizontal), and panning about the vertical axis does not
+/// // move it up or down.
+/// let h = model.gaps(&q)[0];
+/// assert!((h - (0.089159 - 0.09465 + 0.2)).abs() < 1e-9);
+/// assert!(model.gap_jacobian(&q)[(0, 0)].abs() < 1e-12);
+/// ```
+///
+/// Beside `urdf = "path";` (relative to the crate's directory; editing the
+/// URDF rebuilds the model), `locked { joint, ... }` holds joints at zero and
+/// `limits { joint, ... }` turns their `<limit>`s into constraints, as the
+/// YAML keys do; any other item (parameters, `applied` forces such as joint
+/// damping, more constraints, `initial`) is written as in any inline model.
 pub use moreau_macro::model;
 pub use moreau_runtime::*;
 

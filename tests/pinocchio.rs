@@ -1,4 +1,5 @@
-//! URDF models against Pinocchio: `tests/robots/ur5.yaml`,
+//! URDF models against Pinocchio: `tests/robots/ur5.yaml` (and the same
+//! model written inline),
 //! `tests/robots/panda.yaml` (URDFs from example-robot-data, shipped in
 //! `tests/robots/urdf/`), `tests/robots/slider_arm.yaml` and
 //! `tests/robots/serial_12.yaml` (URDFs written for the tests) compiled by `model!`, compared with the values that
@@ -25,6 +26,23 @@ moreau::model!(file = "tests/robots/ur5.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
 moreau::model!(file = "tests/robots/slider_arm.yaml");
 moreau::model!(file = "tests/robots/serial_12.yaml");
+
+/// `tests/robots/ur5.yaml` written inline, the URDF named by `urdf = "...";`.
+mod inline {
+    moreau::model! {
+        pub struct Ur5;
+        urdf = "tests/robots/urdf/ur_description/ur5_robot.urdf";
+        constraints {
+            tool_x: position_x(tool0, 0.01, -0.02, 0.05) <= 1.0,
+            tool_y: position_y(tool0, 0.01, -0.02, 0.05) <= 1.0,
+            table: position_z(tool0, 0.01, -0.02, 0.05) + 0.5 >= 0,
+            forearm_x: position_x(forearm_link) <= 1.0,
+            forearm_y: position_y(forearm_link) <= 1.0,
+            forearm_z: position_z(forearm_link) + 0.5 >= 0,
+        }
+        restitution = 0.2;
+    }
+}
 
 const RTOL: f64 = 1e-10;
 
@@ -143,20 +161,24 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
     );
 }
 
+const UR5_JOINTS: [&str; 6] = [
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+];
+
 #[test]
 fn ur5_matches_pinocchio() {
-    compare(
-        &Ur5::<f64>::new(),
-        "ur5",
-        [
-            "shoulder_pan_joint",
-            "shoulder_lift_joint",
-            "elbow_joint",
-            "wrist_1_joint",
-            "wrist_2_joint",
-            "wrist_3_joint",
-        ],
-    );
+    compare(&Ur5::<f64>::new(), "ur5", UR5_JOINTS);
+}
+
+/// The same URDF through the inline front end.
+#[test]
+fn inline_ur5_matches_pinocchio() {
+    compare(&inline::Ur5::<f64>::new(), "ur5", UR5_JOINTS);
 }
 
 #[test]

@@ -2,7 +2,8 @@
 //!
 //! It reads a Lagrangian model with unilateral constraints, either from a YAML
 //! file (`model!(file = "models/parabola.yaml")`) or written inline
-//! (`model! { pub struct Parabola; ... }`), and emits a fixed-size,
+//! (`model! { pub struct Parabola; ... }`), either perhaps naming a URDF,
+//! and emits a fixed-size,
 //! allocation-free implementation of `moreau::Model` (plus
 //! `Sensitivities` and `Enclosure`). The stages are kept apart, as in
 //! `serde_derive` and `thiserror-impl`, each reading only the data type the
@@ -10,7 +11,7 @@
 //!
 //! | stage | module | reads | produces |
 //! |---|---|---|---|
-//! | front ends | `front::yaml`, `front::inline` (a URDF through `front::urdf`) | YAML text, or tokens | `ModelSpec` (`spec.rs`): the model as written, every name and expression with its location |
+//! | front ends | `front::yaml`, `front::inline` (a URDF, for both, through `front::urdf_keys` and `front::urdf`) | YAML text, or tokens | `ModelSpec` (`spec.rs`): the model as written, every name and expression with its location |
 //! | checks | `check` | `ModelSpec` and its `Scope` | errors (every one at once), nothing else |
 //! | resolution | `resolve` | a checked `ModelSpec` | `Resolved` (`resolve.rs`): expressions over typed `Symbol`s, `kinetic` required, per-coordinate applied forces |
 //! | lowering | `lower` (a kinematic tree's M, C, G, C v + G by recursions: `tree`) | `Resolved` | the symbolic graph and every derived quantity (`moreau_sym::Mechanics`, laid out by `moreau_sym::Layout`) |
@@ -56,7 +57,10 @@ use proc_macro::TokenStream;
 
 /// Compiles a mechanical model into a type implementing `moreau::Model`.
 ///
-/// See the `moreau` crate for the documentation and examples.
+/// The model is a YAML file (`model!(file = "models/parabola.yaml")`) or
+/// written inline (`model! { pub struct Name; ... }`); either may name a
+/// URDF (`urdf: path` in YAML, `urdf = "path";` inline) beside its
+/// constraints. See the `moreau` crate for the documentation and examples.
 #[proc_macro]
 pub fn model(input: TokenStream) -> TokenStream {
     expand::model(input.into()).into()

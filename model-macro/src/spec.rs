@@ -108,14 +108,9 @@ pub(crate) struct Body {
 /// Where the model was written.
 #[derive(Clone, Debug)]
 pub(crate) enum Origin {
-    /// A YAML file: its absolute path (for `include_bytes!`), its text,
-    /// and the absolute paths of the other files it reads (a URDF), also
-    /// tracked so that editing them rebuilds the model.
-    Yaml {
-        path: String,
-        text: String,
-        reads: Vec<String>,
-    },
+    /// A YAML file: its absolute path (for `include_bytes!`, so that
+    /// editing it rebuilds the model) and its text.
+    Yaml { path: String, text: String },
     /// Inline tokens.
     Inline,
 }
@@ -146,6 +141,9 @@ pub(crate) struct ModelSpec {
     /// Where `bodies` was written (for messages about the tree as a whole).
     pub bodies_loc: Option<Loc>,
     pub origin: Origin,
+    /// The absolute paths of the other files the model reads (a URDF),
+    /// tracked by `include_bytes!` like a YAML model's file.
+    pub reads: Vec<String>,
     /// Definitions whose expression could not be read (the front end has
     /// reported why): their uses are not reported again as unknown names.
     pub unreadable: Vec<Name>,

@@ -42,12 +42,11 @@ impl Emitter<'_, '_> {
     /// Every item of the generated type.
     pub(super) fn items(&self) -> TokenStream {
         let strukt = self.struct_item();
-        let tracking = match &self.model.spec.origin {
-            Origin::Yaml { path, reads, .. } => {
-                quote! { #(const _: &[u8] = ::core::include_bytes!(#reads);)* const _: &[u8] = ::core::include_bytes!(#path); }
-            }
-            Origin::Inline => TokenStream::new(),
-        };
+        let reads = &self.model.spec.reads;
+        let mut tracking = quote! { #(const _: &[u8] = ::core::include_bytes!(#reads);)* };
+        if let Origin::Yaml { path, .. } = &self.model.spec.origin {
+            tracking.extend(quote! { const _: &[u8] = ::core::include_bytes!(#path); });
+        }
         let inherent = self.inherent_items();
         let model = self.model_impl();
         let sensitivities = self.sensitivities_impl();

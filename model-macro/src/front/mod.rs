@@ -3,5 +3,6 @@
 
 pub(crate) mod inline;
 pub(crate) mod urdf;
+pub(crate) mod urdf_keys;
 pub(crate) mod yaml;
 pub(crate) mod yaml_tree;

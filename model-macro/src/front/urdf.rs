@@ -1,5 +1,6 @@
-//! URDF import: a model file's `urdf: path` key names a URDF whose links
-//! and joints become the model's `bodies` (see `models/README.md`).
+//! URDF import: a model's `urdf` key (`urdf: path` in YAML, `urdf =
+//! "path";` inline; read by `urdf_keys.rs`) names a URDF whose links and
+//! joints become the model's `bodies` (see `models/README.md`).
 //!
 //! The XML is read with `roxmltree`. The mapping, for a fixed base:
 //!
@@ -20,7 +21,8 @@
 //!   fixed joints (Pinocchio's `buildReducedModel` at the zero
 //!   configuration).
 //!
-//! `floating` and `planar` joints are refused with an error that says why,
+//! `floating` (a quaternion base, out of scope) and `planar` joints are
+//! refused with an error that says why,
 //! as are `mimic` joints that are not locked; every problem in the file is
 //! reported at once, each with the URDF's `path:line:column`.
 
@@ -68,23 +70,25 @@ pub(crate) struct Limit {
     pub upper: f64,
 }
 
-/// Reads the URDF `text` (shown in messages as `display`). Every problem is
-/// returned as a message that starts with `display:line:column`; `loc` is
-/// where the model names the file, and every imported name and number
-/// points there. `locked` names joints to hold at zero; the ones the file
-/// does not have are reported.
+/// Reads the URDF `text` (shown in messages as `display`). `loc` is where
+/// the model names the file, and every imported name and number points
+/// there. Every problem is returned with where to report it: a problem of
+/// the file at `loc`, its message starting with `display:line:column`; a
+/// joint of `locked` (the joints to hold at zero) that the file does not
+/// have at that name.
 pub(crate) fn import(
     display: &str,
     text: &str,
     loc: Loc,
     locked: &[Name],
-) -> Result<Imported, Vec<String>> {
+) -> Result<Imported, Vec<(Loc, String)>> {
+    let at_file = |messages: Vec<String>| messages.into_iter().map(|m| (loc, m)).collect();
     let doc = roxmltree::Document::parse(text).map_err(|e| {
         let pos = e.pos();
-        vec![format!(
+        at_file(vec![format!(
             "{display}:{}:{}: malformed URDF: {e}",
             pos.row, pos.col
-        )]
+        )])
     })?;
     let mut errors = Vec::new();
     let at = |node: roxmltree::Node<'_, '_>| {
@@ -93,11 +97,11 @@ pub(crate) fn import(
     };
     let root = doc.root_element();
     if root.tag_name().name() != "robot" {
-        return Err(vec![format!(
+        return Err(at_file(vec![format!(
             "{}: a URDF's root element is <robot>, found <{}>",
             at(root),
             root.tag_name().name()
-        )]);
+        )]));
     }
     let mut links: Vec<(&str, Inertial)> = Vec::new();
     let mut joints: Vec<UrdfJoint<'_>> = Vec::new();
@@ -118,31 +122,36 @@ pub(crate) fn import(
             _ => {}
         }
     }
-    let root = check_tree(display, &links, &joints, locked, &mut errors);
+    let root = check_tree(display, &links, &joints, &mut errors);
+    let mut problems: Vec<(Loc, String)> = at_file(errors);
+    for l in locked {
+        if !joints.iter().any(|j| j.name == l.text) {
+            problems.push((
+                l.loc,
+                format!(
+                    "`{}` is not a joint of {display}: it cannot be locked",
+                    l.text
+                ),
+            ));
+        }
+    }
     match root {
-        Some(root) if errors.is_empty() => walk(display, &links, &joints, root, loc),
-        _ => Err(errors),
+        Some(root) if problems.is_empty() => {
+            walk(display, &links, &joints, root, loc).map_err(at_file)
+        }
+        _ => Err(problems),
     }
 }
 
 /// Checks that the joints make one tree over the links (every link named
-/// exists, each link the child of at most one joint, one root) and that
-/// every locked joint exists; the root link, or `None` with `errors`.
+/// exists, each link the child of at most one joint, one root); the root
+/// link, or `None` with `errors`.
 fn check_tree<'a>(
     display: &str,
     links: &[(&'a str, Inertial)],
     joints: &[UrdfJoint<'a>],
-    locked: &[Name],
     errors: &mut Vec<String>,
 ) -> Option<&'a str> {
-    for l in locked {
-        if !joints.iter().any(|j| j.name == l.text) {
-            errors.push(format!(
-                "{display}: `locked` names the joint `{}`, which this URDF does not have",
-                l.text
-            ));
-        }
-    }
     let inertials: HashMap<&str, Inertial> = links.iter().copied().collect();
     let mut child_of: HashMap<&str, usize> = HashMap::new();
     for (i, j) in joints.iter().enumerate() {
@@ -402,8 +411,13 @@ fn joint<'a>(
         "prismatic" => JointKind::Prismatic,
         "fixed" => JointKind::Fixed,
         "floating" | "planar" => {
+            let why = if kind == "floating" {
+                "a floating base, whose orientation is a quaternion, is out of scope"
+            } else {
+                "a planar joint is not supported"
+            };
             errors.push(format!(
-                "{}: joint `{name}` is {kind}: a {kind} base is not supported (a fixed base only; write a planar or spatial base as explicit prismatic and revolute joints, or lock it with `locked`)",
+                "{}: joint `{name}` is {kind}: {why}; the base is fixed (write a planar or spatial base as explicit prismatic and revolute joints in `bodies`, or list the joint in `locked` to hold it at zero)",
                 at(node)
             ));
             return None;
@@ -420,7 +434,7 @@ fn joint<'a>(
         && !is_locked
     {
         errors.push(format!(
-            "{}: joint `{name}` mimics another joint, which is not supported: lock it (`locked: [{name}]`)",
+            "{}: joint `{name}` mimics another joint, which is not supported: list it in `locked` to hold it at zero",
             at(m)
         ));
         return None;

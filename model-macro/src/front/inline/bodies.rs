@@ -1,8 +1,88 @@
 //! The inline front end's reading of a kinematic tree:
-//! `bodies { name: { parent, joint, axis, xyz, rpy, mass, com, inertia } }`
-//! and `gravity = [x, y, z];`.
+//! `bodies { name: { parent, joint, axis, xyz, rpy, mass, com, inertia } }`,
+//! `gravity = [x, y, z];`, and a URDF: `urdf = "path";`, `locked { j1 }`,
+//! `limits { j2 }`, imported by `front/urdf_keys.rs` exactly as the YAML
+//! keys `urdf`, `locked` and `limits` are.
 
 use super::*;
+use crate::front::urdf_keys::import_urdf;
+
+/// The URDF items of an inline model, kept until every item is read.
+#[derive(Default)]
+pub(super) struct UrdfItems {
+    /// `urdf = "path";`: the path, located at its literal.
+    path: Option<Name>,
+    /// Whether `urdf` was written at all (its path perhaps unreadable).
+    written: bool,
+    /// `locked { ... }`: the joints held at zero.
+    locked: Vec<Name>,
+    /// `limits { ... }`: the joints whose `<limit>` become constraints.
+    limits: Vec<Name>,
+    /// Where `locked` and `limits` were written, with the key.
+    keys: Vec<(Loc, &'static str)>,
+}
+
+impl UrdfItems {
+    /// Reads the item `key rest` when `key` is `urdf`, `locked` or
+    /// `limits`; `false` (and nothing read) for any other key.
+    pub(super) fn read(&mut self, cx: &Ctxt, key: &str, loc: Loc, rest: &[TokenTree]) -> bool {
+        self.written |= key == keys::URDF;
+        match (key, rest) {
+            (keys::URDF, [eq, TokenTree::Literal(lit)]) if is_punct(eq, '=') => {
+                match syn::parse2::<syn::LitStr>(TokenTree::Literal(lit.clone()).into()) {
+                    Ok(path) => {
+                        self.path = Some(Name {
+                            text: path.value(),
+                            loc: Loc::span(path.span()),
+                        });
+                    }
+                    Err(_) => cx.error(
+                        Loc::span(lit.span()),
+                        "expected the URDF's path as a string, `urdf = \"path/to/robot.urdf\";` (relative to the crate's directory)",
+                    ),
+                }
+            }
+            (keys::URDF, _) => cx.error(
+                loc,
+                "expected `urdf = \"path/to/robot.urdf\";` (relative to the crate's directory)",
+            ),
+            (keys::LOCKED | keys::LIMITS, [TokenTree::Group(g)]) => {
+                let names = names(cx, g, "a joint name of the URDF");
+                if key == keys::LOCKED {
+                    self.locked = names;
+                    self.keys.push((loc, keys::LOCKED));
+                } else {
+                    self.limits = names;
+                    self.keys.push((loc, keys::LIMITS));
+                }
+            }
+            (keys::LOCKED | keys::LIMITS, _) => cx.error(
+                loc,
+                format!("expected `{key} {{ joint1, joint2 }}`: joint names of the URDF"),
+            ),
+            _ => return false,
+        }
+        true
+    }
+
+    /// Imports the URDF into `spec`, or reports `locked` and `limits`
+    /// written without one.
+    pub(super) fn import(self, cx: &Ctxt, spec: &mut ModelSpec) {
+        match &self.path {
+            Some(path) => import_urdf(cx, spec, path, &self.locked, &self.limits),
+            // A malformed `urdf` item has been reported.
+            None if self.written => {}
+            None => {
+                for (loc, key) in self.keys {
+                    cx.error(
+                        loc,
+                        format!("`{key}` names joints of a URDF, but this model has no `urdf = \"...\";`"),
+                    );
+                }
+            }
+        }
+    }
+}
 
 /// `[a, b, c]`: `K` expressions in brackets.
 pub(super) fn vector<const K: usize>(

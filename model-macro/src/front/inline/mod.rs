@@ -15,11 +15,15 @@
 //! initial { x: 1.0, vx: 3.0 }
 //! bodies { link: { joint: revolute(th: w), axis: [0, 1, 0], mass: m, com: [0, 0, -l] } }
 //! gravity = [0, 0, -g];
+//! urdf = "robots/arm.urdf";
+//! locked { finger }
+//! limits { elbow }
 //! ```
 //!
 //! The body is cut into items by hand (a brace group, or everything up to
 //! `;`), so one malformed item is reported and the others are still read.
-//! The kinematic tree (`bodies`, `gravity`) is read in `bodies.rs`.
+//! The kinematic tree (`bodies`, `gravity`, and `urdf`, `locked`, `limits`,
+//! which mean what the YAML keys mean) is read in `bodies.rs`.
 
 mod bodies;
 
@@ -42,17 +46,7 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         .iter()
         .position(|t| is_punct(t, ';'))
         .map_or(trees.len(), |i| i + 1);
-    let header: TokenStream = trees[..header_end].iter().cloned().collect();
-    let header: Header = match syn::parse2(header) {
-        Ok(h) => h,
-        Err(e) => {
-            cx.error(
-                Loc::span(e.span()),
-                format!("{e}; an inline model starts with `pub struct Name;` (or `model!(file = \"...\")` for a YAML file)"),
-            );
-            return None;
-        }
-    };
+    let header = header(cx, &trees, header_end)?;
     let mut spec = ModelSpec {
         name: Name {
             text: header.ident.to_string(),
@@ -77,16 +71,20 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         gravity: None,
         bodies_loc: None,
         origin: Origin::Inline,
+        reads: Vec::new(),
         unreadable: Vec::new(),
     };
     let mut seen: Vec<String> = Vec::new();
+    let mut urdf = bodies::UrdfItems::default();
     let mut rest = &trees[header_end..];
     while !rest.is_empty() {
         let (item, after) = next_item(rest);
         rest = after;
-        read_item(cx, &mut spec, &mut seen, item);
+        read_item(cx, &mut spec, &mut seen, &mut urdf, item);
     }
-    let has_bodies = seen.iter().any(|s| s == keys::BODIES);
+    // Read after the other items, whatever their order, as in YAML.
+    urdf.import(cx, &mut spec);
+    let has_bodies = seen.iter().any(|s| s == keys::BODIES || s == keys::URDF);
     for (key, what) in [
         (keys::COORDINATES, "its coordinates (or `bodies`)"),
         (keys::KINETIC, "its kinetic energy (or `bodies`)"),
@@ -99,6 +97,27 @@ pub(crate) fn build(cx: &Ctxt, input: TokenStream) -> Option<ModelSpec> {
         }
     }
     Some(spec)
+}
+
+/// Reads `/// docs pub struct Name;`, the first `end` trees; `None` after
+/// reporting what is wrong.
+fn header(cx: &Ctxt, trees: &[TokenTree], end: usize) -> Option<Header> {
+    let header: TokenStream = trees[..end].iter().cloned().collect();
+    match syn::parse2(header) {
+        Ok(h) => Some(h),
+        Err(e) => {
+            let message = match trees {
+                [TokenTree::Ident(k), eq, ..] if k == keys::URDF && is_punct(eq, '=') => {
+                    "an inline model starts with its name, then names its URDF: `pub struct Robot; urdf = \"path/to/robot.urdf\"; ...`".to_string()
+                }
+                _ => format!(
+                    "{e}; an inline model starts with `pub struct Name;` (or `model!(file = \"...\")` for a YAML file)"
+                ),
+            };
+            cx.error(Loc::span(e.span()), message);
+            None
+        }
+    }
 }
 
 struct Header {
@@ -136,7 +155,13 @@ fn next_item(trees: &[TokenTree]) -> (&[TokenTree], &[TokenTree]) {
     }
 }
 
-fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[TokenTree]) {
+fn read_item(
+    cx: &Ctxt,
+    spec: &mut ModelSpec,
+    seen: &mut Vec<String>,
+    urdf: &mut bodies::UrdfItems,
+    item: &[TokenTree],
+) {
     let Some(first) = item.first() else { return };
     let TokenTree::Ident(key) = first else {
         cx.error(
@@ -160,7 +185,9 @@ fn read_item(cx: &Ctxt, spec: &mut ModelSpec, seen: &mut Vec<String>, item: &[To
         return;
     }
     seen.push(key_text.clone());
-    read_keyed(cx, spec, &key_text, loc, &item[1..]);
+    if !urdf.read(cx, &key_text, loc, &item[1..]) {
+        read_keyed(cx, spec, &key_text, loc, &item[1..]);
+    }
 }
 
 /// Reads the item `key ...` (`rest` is what follows the key).
@@ -191,7 +218,7 @@ fn read_keyed(cx: &Ctxt, spec: &mut ModelSpec, key_text: &str, loc: Loc, rest: &
         }
         (keys::GRAVITY, _) => cx.error(loc, "expected `gravity = [x, y, z];`"),
         (keys::PARAMETERS, [TokenTree::Group(g)]) => spec.parameters = parameters(cx, g),
-        (keys::INPUTS, [TokenTree::Group(g)]) => spec.inputs = inputs(cx, g),
+        (keys::INPUTS, [TokenTree::Group(g)]) => spec.inputs = names(cx, g, "an input name"),
         (keys::APPLIED, [TokenTree::Group(g)]) => spec.applied = applied(cx, g),
         (keys::CONSTRAINTS, [TokenTree::Group(g)]) => {
             spec.constraints = entries(cx, g)
@@ -220,7 +247,7 @@ fn read_keyed(cx: &Ctxt, spec: &mut ModelSpec, key_text: &str, loc: Loc, rest: &
         (other, _) => cx.error(
             loc,
             format!(
-                "unknown item `{other}`; a model has coordinates, parameters, inputs, let, bodies, gravity, kinetic, potential, applied, constraints, restitution, initial"
+                "unknown item `{other}`; a model has coordinates, parameters, inputs, let, urdf, locked, limits, bodies, gravity, kinetic, potential, applied, constraints, restitution, initial"
             ),
         ),
     }
@@ -266,8 +293,9 @@ fn initial(cx: &Ctxt, g: &Group) -> Vec<(Name, Number)> {
         .collect()
 }
 
-/// `inputs { u1, u2 }`: names only.
-fn inputs(cx: &Ctxt, g: &Group) -> Vec<Name> {
+/// `inputs { u1, u2 }` (and `locked`, `limits`): names only; `what` says
+/// what a name should be, in the message for anything else.
+fn names(cx: &Ctxt, g: &Group, what: &str) -> Vec<Name> {
     split_commas(g.stream())
         .into_iter()
         .filter_map(|tokens| match tokens.as_slice() {
@@ -277,7 +305,7 @@ fn inputs(cx: &Ctxt, g: &Group) -> Vec<Name> {
             }),
             _ => {
                 let span = tokens.first().map_or(g.span(), TokenTree::span);
-                cx.error(Loc::span(span), "expected an input name");
+                cx.error(Loc::span(span), format!("expected {what}"));
                 None
             }
         })

@@ -4,7 +4,8 @@
 //! must lie inside it. Its tree is walked key by key; an unknown or
 //! malformed entry is recorded and skipped, so that every mistake in the file
 //! is reported at once, each with `path:line:column`. The kinematic tree
-//! (`bodies`, `urdf`, `limits`) is read in `bodies.rs`.
+//! (`bodies`) is read in `bodies.rs`, a URDF (`urdf`, `locked`, `limits`)
+//! by `front/urdf_keys.rs`, which the inline front end shares.
 
 mod bodies;
 
@@ -13,6 +14,7 @@ use std::path::{Path, PathBuf};
 use proc_macro2::Span;
 use quote::quote;
 
+use super::urdf_keys::{import_urdf, read_crate_file};
 use super::yaml_tree::{YKind, YNode, YamlSource};
 use crate::ctxt::{Ctxt, Locate};
 use crate::expr::{self, Expr};
@@ -51,46 +53,7 @@ impl syn::parse::Parse for FileArgs {
 /// Finds and reads the model file. Errors (missing, unreadable, outside the
 /// crate) point at the path literal.
 pub(crate) fn read(args: &FileArgs) -> syn::Result<(YamlSource, PathBuf)> {
-    read_file(&args.path.value(), args.path.span(), "model file")
-}
-
-/// Reads the file at `relative` (to the crate's directory, and inside it);
-/// `what` names it in messages.
-fn read_file(relative: &str, span: Span, what: &str) -> syn::Result<(YamlSource, PathBuf)> {
-    let relative = relative.to_string();
-    let manifest = std::env::var("CARGO_MANIFEST_DIR")
-        .map_err(|_| syn::Error::new(span, "CARGO_MANIFEST_DIR is not set; build with cargo"))?;
-    let root = Path::new(&manifest).canonicalize().map_err(|e| {
-        syn::Error::new(
-            span,
-            format!("cannot resolve the crate directory `{manifest}`: {e}"),
-        )
-    })?;
-    let path = root.join(&relative).canonicalize().map_err(|e| {
-        syn::Error::new(
-            span,
-            format!(
-                "cannot read {what} `{relative}` (paths are relative to the crate's directory): {e}"
-            ),
-        )
-    })?;
-    if !path.starts_with(&root) {
-        return Err(syn::Error::new(
-            span,
-            format!(
-                "{what} `{relative}` is outside this crate; keep model files inside the crate's directory"
-            ),
-        ));
-    }
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| syn::Error::new(span, format!("cannot read {what} `{relative}`: {e}")))?;
-    Ok((
-        YamlSource {
-            display: relative,
-            text,
-        },
-        path,
-    ))
+    read_crate_file(&args.path.value(), args.path.span(), "model file")
 }
 
 /// Parses the YAML text; a syntax error is reported with its position.
@@ -127,7 +90,7 @@ pub(crate) fn build(
     };
     let mut spec = empty_spec(w.loc(root), path, text);
     let mut seen: Vec<&str> = Vec::new();
-    let (mut urdf, mut locked): (Option<(Name, &YNode)>, Vec<Name>) = (None, Vec::new());
+    let (mut urdf, mut locked): (Option<Name>, Vec<Name>) = (None, Vec::new());
     let mut limits: Vec<Name> = Vec::new();
     for (key, value) in entries {
         let Some(k) = w.key(key) else { continue };
@@ -138,9 +101,7 @@ pub(crate) fn build(
         match k.text.as_str() {
             // Read after the other keys, whatever their order.
             keys::URDF => {
-                if let Some(path) = w.name(value, "the URDF file's path") {
-                    urdf = Some((path, value));
-                }
+                urdf = w.name(value, "the URDF file's path");
                 seen.push(keys::URDF);
             }
             keys::LOCKED | keys::LIMITS => {
@@ -160,8 +121,10 @@ pub(crate) fn build(
             }
         }
     }
-    if let Some((urdf, node)) = urdf {
-        w.import_urdf(&mut spec, &urdf, node, &locked, &limits);
+    if let Some(urdf) = urdf {
+        import_urdf(cx, &mut spec, &urdf, &locked, &limits);
+    } else if seen.contains(&keys::URDF) {
+        // A malformed `urdf` value has been reported.
     } else if let Some(first) = locked.first().or(limits.first()) {
         cx.error(
             first.loc,
@@ -197,8 +160,8 @@ fn empty_spec(loc: Loc, path: &Path, text: String) -> ModelSpec {
         origin: Origin::Yaml {
             path: path.display().to_string(),
             text,
-            reads: Vec::new(),
         },
+        reads: Vec::new(),
         unreadable: Vec::new(),
     }
 }
