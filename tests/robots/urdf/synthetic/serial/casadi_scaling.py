@@ -49,7 +49,8 @@ Figures per N:
 * build: building the SX expressions and the Function with ``cse=True``
   (Pinocchio's URDF parsing excluded); generate: ``CodeGenerator`` writing
   the C file; gcc: the wall time of ``gcc -O3 -c`` on it (one process).
-  Each time is the median of ``--repeat`` runs (default 3).
+  Each time is the smallest of ``--repeat`` runs (default 3; other load on
+  the machine only adds time).
 
 Usage (a venv with tests/requirements-casadi.txt and
 tests/requirements-pinocchio.txt, e.g. ``python3 -m venv /tmp/venv-both``
@@ -62,7 +63,6 @@ then ``pip install`` both)::
 from __future__ import annotations
 
 import argparse
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -454,9 +454,9 @@ def measure(ca, pin, n: int, coriolis: str, repeat: int, out: Path):
         "ops": op_count(ca, fused),
         "instructions": fused.n_instructions(),
         "dynamics": op_count(ca, dynamics(ca, fused)),
-        "build": statistics.median(builds),
-        "generate": statistics.median(gens),
-        "gcc": statistics.median(gccs),
+        "build": min(builds),
+        "generate": min(gens),
+        "gcc": min(gccs),
         "err": err,
     }
 
