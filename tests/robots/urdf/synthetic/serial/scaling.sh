@@ -5,7 +5,8 @@
 # form, one constraint on the last link), expanded and built in release
 # with one job. Prints N, the fused evaluation's operation count, the
 # macro's expansion time (MOREAU_TIMINGS) and the wall time of the crate's
-# own release build (its dependencies built beforehand).
+# own release build (its dependencies built beforehand). CasADi's side of
+# the same table: casadi_scaling.py beside this script.
 #
 #     tests/robots/urdf/synthetic/serial/scaling.sh [N ...]
 set -euo pipefail
