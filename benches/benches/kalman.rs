@@ -1,5 +1,7 @@
 //! One update of the saltation Kalman filter beside one update of the
-//! reduced-order observer (38), in one run, on Example 1 sampled at 1 kHz
+//! reduced-order observer (38), of the full-order observer (36) and of a
+//! backward finite difference of the samples (the estimators of the noise
+//! sweep's table), in one run, on Example 1 sampled at 1 kHz
 //! with σ = 1e-4: in free flight, with an impact inside the interval, and
 //! sliding. Each estimator is first run over the record up to the
 //! interval, so it starts from its own converged state; the copy of it
@@ -9,8 +11,8 @@
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use moreau::{
-    KalmanParams, MoreauJean, Observer, ObserverParams, ReducedOrder, SaltationKalman, State,
-    StepParams,
+    FullOrder, FullOrderGains, KalmanParams, MoreauJean, Observer, ObserverParams, ReducedOrder,
+    SaltationKalman, State, StepParams,
 };
 use moreau_models::Parabola;
 use nalgebra::{SVector, Vector2};
@@ -63,17 +65,23 @@ fn updates(c: &mut Criterion) {
         let mut kalman =
             SaltationKalman::<f64, 2, 2>::new(kalman_params, 0.0, data[0].1, Vector2::zeros())
                 .unwrap();
-        let mut reduced = ReducedOrder::<f64, 2, 2>::new(
-            ObserverParams::new(10.0, 20.0).with_noise(1e-4),
-            0.0,
-            data[0].1,
-            Vector2::zeros(),
-        )
-        .unwrap();
+        let observer_params = ObserverParams::new(10.0, 20.0).with_noise(1e-4);
+        let mut reduced =
+            ReducedOrder::<f64, 2, 2>::new(observer_params, 0.0, data[0].1, Vector2::zeros())
+                .unwrap();
+        let gains = FullOrderGains::scalar(5.0, 25.0);
+        let mut full =
+            FullOrder::<f64, 2, 2>::new(observer_params, gains, 0.0, data[0].1, Vector2::zeros())
+                .unwrap();
         for (t, q, _) in &data[1..k] {
             kalman.update(&model, *t, q, &u).unwrap();
             reduced.update(&model, *t, q, &u).unwrap();
+            full.update(&model, *t, q, &u).unwrap();
         }
+        let previous = Difference {
+            t: data[k - 1].0,
+            q: data[k - 1].1,
+        };
         let (t, q, _) = data[k];
         // what the interval holds for each, checked before timing
         let mut probe = kalman;
@@ -100,8 +108,38 @@ fn updates(c: &mut Criterion) {
                 BatchSize::SmallInput,
             )
         });
+        group.bench_function(format!("full (36), {label}"), |b| {
+            b.iter_batched_ref(
+                || full,
+                |o| o.update(&model, black_box(t), &q, &u).unwrap(),
+                BatchSize::SmallInput,
+            )
+        });
+        group.bench_function(format!("finite difference, {label}"), |b| {
+            b.iter_batched_ref(
+                || previous,
+                |d| d.update(black_box(t), &q),
+                BatchSize::SmallInput,
+            )
+        });
     }
     group.finish();
+}
+
+/// The backward difference of the samples, `(q_k − q_{k−1}) / (t_k −
+/// t_{k−1})`, kept as an estimator with the last sample as its state.
+#[derive(Clone, Copy)]
+struct Difference {
+    t: f64,
+    q: Vector2<f64>,
+}
+
+impl Difference {
+    fn update(&mut self, t: f64, q: &Vector2<f64>) -> Vector2<f64> {
+        let v = (q - self.q) / (t - self.t);
+        (self.t, self.q) = (t, *q);
+        v
+    }
 }
 
 criterion_group!(benches, updates);
