@@ -48,17 +48,31 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
     pub evaluations: u32,
 }
 
-/// Picks the process noise of `params` for a recorded run by maximising
-/// the innovation log-likelihood over a factor `s` applied to
-/// [`KalmanParams::accel_noise`], `s ∈ [10^lo, 10^hi]`: a grid of nine
-/// points in `log s`, then golden-section search (24 steps) around the
-/// best point of the grid. Each evaluation runs a filter over the record
-/// from `(t[0], q[0])` with the velocity estimate `v0`; nothing allocates.
+/// Picks the four process-noise knobs of `params` (acceleration, impact,
+/// impact-time and contact noise) for a recorded run by maximising the
+/// innovation log-likelihood, each knob scaled by a factor `10^x`, `x ∈
+/// [lo, hi]`: coordinate ascent in the exponents, a first sweep with a
+/// grid of seven points per knob and golden-section search around the
+/// best, a second with golden-section search around the first's point.
+/// Each evaluation runs a filter over the record from `(t[0], q[0])` with
+/// the velocity estimate `v0`; nothing allocates.
 ///
 /// A user with data does not tune by hand: the likelihood is largest where
 /// the innovations are as large as the filter expects them, neither
 /// smaller (too much process noise: the filter follows the noise) nor
 /// larger (too little: it lags the motion).
+///
+/// Where the record cannot tell (a likelihood flat over decades of a knob,
+/// as a short or uneventful record leaves it), the maximum is anywhere in
+/// the flat region, and a knob picked there does worse on other runs than
+/// the knob it started from. So each exponent carries a weak prior,
+/// normal with a standard deviation of one decade around the given knob
+/// (`x = 0`): the search maximises the log-likelihood minus `x²/2` per
+/// knob (maximum a posteriori). A record that asks for a knob a decade
+/// away pays half a nat for it, while the likelihood of a record that
+/// needs the change moves by tens to thousands of nats: such a record
+/// still moves the knob freely; a flat one leaves it where it was.
+/// [`Tuning::log_likelihood`] is the likelihood itself, without the prior.
 ///
 /// ```
 /// use moreau_runtime::{KalmanParams, Model, ModelInfo, Sensitivities, tune_process_noise};
@@ -136,7 +150,12 @@ where
     }
     let ten: T = nalgebra::convert(10.0);
     let mut evaluations = 0u32;
-    let mut likelihood = |x: &[T; KNOBS]| -> Result<T, ObserverError<T>> {
+    // the prior: normal in each exponent, one decade around the given knob
+    let prior = |x: &[T; KNOBS]| -> T {
+        let half: T = nalgebra::convert(0.5);
+        x.iter().fold(T::zero(), |acc, &xk| acc - half * xk * xk)
+    };
+    let mut posterior = |x: &[T; KNOBS]| -> Result<T, ObserverError<T>> {
         evaluations += 1;
         let p = params.scaled_by(&NoiseFactors::from_exponents(x, ten));
         let mut filter = SaltationKalman::<T, N, K>::new(p, t[0], q[0], *v0)?;
@@ -153,7 +172,7 @@ where
             };
             total += capped.log_likelihood(N);
         }
-        Ok(total)
+        Ok(total + prior(x))
     };
     // coordinate ascent in the exponents, from the defaults (0): the
     // first sweep a grid over [lo, hi] and golden-section search around
@@ -161,7 +180,7 @@ where
     // sweep's point
     let step = (hi - lo) / nalgebra::convert((GRID - 1) as f64);
     let mut x = [T::zero(); KNOBS];
-    let mut best = likelihood(&x)?;
+    let mut best = posterior(&x)?;
     for sweep in 0..2 {
         for knob in 0..KNOBS {
             let mut centre = x[knob];
@@ -169,7 +188,7 @@ where
                 for j in 0..GRID {
                     let mut y = x;
                     y[knob] = lo + step * nalgebra::convert(j as f64);
-                    let l = likelihood(&y)?;
+                    let l = posterior(&y)?;
                     if l > best {
                         (best, centre) = (l, y[knob]);
                     }
@@ -179,7 +198,7 @@ where
             let (xk, l) = golden(bracket, |v| {
                 let mut y = x;
                 y[knob] = v;
-                likelihood(&y)
+                posterior(&y)
             })?;
             x[knob] = if l > best { xk } else { centre };
             best = best.max(l);
@@ -189,7 +208,7 @@ where
     Ok(Tuning {
         params: params.scaled_by(&factors),
         factors,
-        log_likelihood: best,
+        log_likelihood: best - prior(&x),
         evaluations,
     })
 }
