@@ -1,6 +1,6 @@
 //! Fuzz suite (issue 9): random, extreme and non-finite inputs mixed into
-//! valid streams for the plant stepper and both observers, on every shipped
-//! model. Asserted, for every input:
+//! valid streams for the plant stepper, both observers and the saltation
+//! Kalman filter, on every shipped model. Asserted, for every input:
 //!
 //! - no panic (the test would fail), and no non-finite output: every `Ok`
 //!   state or estimate is finite, every estimate within `C_v`;
@@ -18,8 +18,8 @@
 //! observer stream, per model; default 20, 0.4 s in release).
 
 use moreau::{
-    FullOrder, FullOrderGains, Model, MoreauJean, Observer, ObserverError, ObserverParams,
-    ReducedOrder, State, StepParams, UpdateReport,
+    FullOrder, FullOrderGains, KalmanParams, Model, MoreauJean, Observer, ObserverError,
+    ObserverParams, ReducedOrder, SaltationKalman, Sensitivities, State, StepParams, UpdateReport,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
@@ -317,7 +317,7 @@ fn fuzz_model<M, const N: usize, const K: usize, const NU: usize>(
     start: (SVector<f64, N>, SVector<f64, N>),
     rng: &mut Rng,
 ) where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Clone,
+    M: Sensitivities<N, K, Scalar = f64, Input = SVector<f64, NU>> + Clone,
 {
     let (refused, extreme_ok) = fuzz_plant::<_, N, K, NU>(name, &model, start, rng);
     let (samples, speed) = reference::<_, N, K, NU>(&model, start, 0.25 * iterations() as f64);
@@ -330,17 +330,24 @@ fn fuzz_model<M, const N: usize, const K: usize, const NU: usize>(
     let full = FullOrder::<f64, N, K>::new(params, gains, t0, q0, v0).unwrap();
     let r = fuzz_observer::<_, _, N, K, NU>(name, &model, reduced, &samples, velocity_bound, rng);
     let f = fuzz_observer::<_, _, N, K, NU>(name, &model, full, &samples, velocity_bound, rng);
+    let kalman =
+        SaltationKalman::<f64, N, K>::new(KalmanParams::new(velocity_bound, 1e-4), t0, q0, v0)
+            .unwrap();
+    let k = fuzz_observer::<_, _, N, K, NU>(name, &model, kalman, &samples, velocity_bound, rng);
     eprintln!(
-        "{name}: plant {refused} refused, {extreme_ok} extreme accepted; {} samples, reduced {} outliers / {} refused / {} long gaps, full {} / {} / {}",
+        "{name}: plant {refused} refused, {extreme_ok} extreme accepted; {} samples, reduced {} outliers / {} refused / {} long gaps, full {} / {} / {}, Kalman {} / {} / {}",
         samples.len(),
         r[0],
         r[1],
         r[2],
         f[0],
         f[1],
-        f[2]
+        f[2],
+        k[0],
+        k[1],
+        k[2]
     );
-    assert!(r[0] > 0 && f[0] > 0 && refused > 0);
+    assert!(r[0] > 0 && f[0] > 0 && k[0] > 0 && refused > 0);
 }
 
 #[test]

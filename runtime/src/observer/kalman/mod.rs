@@ -4,6 +4,16 @@
 //!
 //! # One interval `[t_k, t_{k+1}]`
 //!
+//! 0. **Screen** the sample as the observers do (module docs of
+//!    `runtime/src/observer/mod.rs`, "Bad samples, bad states, long
+//!    gaps"): one farther from the last accepted sample than the system
+//!    can move is refused ([`ObserverError::Outlier`]), the filter
+//!    untouched; a run of such samples that agree with each other, an
+//!    interval longer than [`ObserverParams::max_interval`] (3 s with
+//!    [`KalmanParams::new`]), or a prediction that fails from the filter's
+//!    own state restarts it from the measurement with the observers'
+//!    restart velocity and a fresh covariance ([`UpdateReport::restart`]).
+//!    Every estimate is held to the velocity bound `C_v`, as theirs are.
 //! 1. **Predict** the state `x = (q, v)` from the estimate `(q̂_k, v̂_k)`
 //!    through the observers' interval: fourth-order Runge–Kutta on the
 //!    model, every impact located inside the interval (Newton's law with
@@ -71,8 +81,11 @@ use nalgebra::{RealField, SMatrix, SVector};
 use crate::lcp::Lcp;
 use crate::model::Sensitivities;
 
-use super::interval::{Cache, Interval, Memory};
-use super::{Estimate, Observer, ObserverError, ObserverParams, UpdateReport};
+use super::interval::{Cache, Interval, Memory, saturate};
+use super::reduced_order::restart_velocity;
+use super::{
+    Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart, UpdateReport,
+};
 use crate::error::DataError;
 use crate::validate;
 use propagate::Propagation;
@@ -440,7 +453,11 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     q: SVector<T, N>,
     v: SVector<T, N>,
     p: Blocks<T, N>,
+    /// Consecutive samples past the innovation gate.
     outliers: u32,
+    /// The observers' physical screen: samples farther than the system can
+    /// move (refused), and the runs of them that restart the filter.
+    screen: Outliers<T, N>,
     report: UpdateReport<T, N, K>,
     kalman: KalmanReport<T>,
     /// The observers' memos (injection gain, a constant `M`'s factor).
@@ -514,6 +531,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             v: v0,
             p: p0,
             outliers: 0,
+            screen: Outliers::NONE,
             report: UpdateReport::new(t0, T::zero()),
             kalman: KalmanReport::empty(),
             cache: Cache::default(),
@@ -578,9 +596,10 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
 /// An update's errors name the problem (a non-finite measurement, input
 /// or parameter, a time not after the last, a model that evaluates to NaN,
 /// an innovation covariance that is not positive definite:
-/// `InvalidParams { name: "measurement" }`); the filter's state is then
-/// unchanged, bit for bit. An outlier is no error: it is reported in
-/// [`KalmanReport::outlier`].
+/// `InvalidParams { name: "measurement" }`, a sample farther than the
+/// system can move: [`ObserverError::Outlier`]); the filter's state is
+/// then unchanged, bit for bit. A sample past the innovation gate is no
+/// error: it is reported in [`KalmanReport::outlier`] and skipped.
 impl<M, T, const N: usize, const K: usize> Observer<M, N, K> for SaltationKalman<T, N, K>
 where
     T: RealField + Copy,
@@ -622,6 +641,20 @@ where
             report: &self.report,
         };
         let (mut interval, mut report) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
+        // SCREEN, as the observers do: a sample farther than the system
+        // can move is refused here, the estimate untouched; a run of such
+        // samples that agree with each other, or an interval longer than
+        // `max_interval`, restarts the filter from the measurement
+        let fresh = report;
+        if let Plan::Restart(why) =
+            self.screen
+                .screen(&self.params.observer, (t, interval.tau), &self.q, q)?
+        {
+            let mut report = fresh;
+            let v = restart_velocity(&interval, &self.v, why, &mut report)?;
+            let (t1, q1) = (interval.t0 + interval.tau, interval.q1);
+            return Ok(self.restarted(t1, q1, v, report));
+        }
         let sigma = rule.noise;
         interval.gain = if sigma > T::zero() {
             sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
@@ -632,7 +665,20 @@ where
         report.gain = interval.gain;
         // PREDICT, the covariance following every piece and impact
         let mut propagation = Propagation::new(model, u, self.t, &self.params, self.p);
-        let (q_pred, v_pred) = interval.predict_traced(&self.v, &mut report, &mut propagation)?;
+        let v0 = saturate(&self.v, self.params.observer.velocity_bound);
+        let (q_pred, v_pred) = match interval.predict_traced(&v0, &mut report, &mut propagation) {
+            Ok(end) => end,
+            // the model or an impact problem failed along the motion
+            // predicted from the filter's own state: start again from
+            // the measurement, as the observers do
+            Err(_) => {
+                let mut report = fresh;
+                let why = Restart::Infeasible;
+                let v = restart_velocity(&interval, &self.v, why, &mut report)?;
+                let (t1, q1) = (interval.t0 + interval.tau, interval.q1);
+                return Ok(self.restarted(t1, q1, v, report));
+            }
+        };
         let (q_pred, v_pred) = (
             q_pred + propagation.correction.0,
             v_pred + propagation.correction.1,
@@ -696,13 +742,40 @@ where
             p = joseph.add(&noise).symmetrized();
             (q_pred + k_q * y, v_pred + k_v * y)
         };
-        // WRITEBACK: only a finite result replaces the state
+        // WRITEBACK: only a finite result replaces the state, its
+        // velocity held to C_v (the projection onto a ball that holds the
+        // true velocity never moves the estimate away from it)
         let finite = |x: &SVector<T, N>| x.iter().all(|x| x.is_finite());
         if !(finite(&q_new) && finite(&v_new) && p.is_finite()) {
             return Err(ObserverError::Data(DataError::NonFiniteResult));
         }
+        let v_new = saturate(&v_new, self.params.observer.velocity_bound);
+        report.outliers = self.screen.accept();
         (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
         Ok(Self::estimate(self))
+    }
+}
+
+impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
+    /// The filter started again at `(t, q)` with the velocity `v` (the
+    /// observers' restart velocity, [`Restart`]: `v̂_k` kept after a run of
+    /// outliers, else the mean velocity over the interval, held to `C_v`
+    /// and closed at the measurement) and the covariance of a fresh filter
+    /// (`R` on the position, [`KalmanParams::initial_velocity_sigma`]`²`
+    /// on the velocity); `report` records why.
+    fn restarted(
+        &mut self,
+        t: T,
+        q: SVector<T, N>,
+        v: SVector<T, N>,
+        mut report: UpdateReport<T, N, K>,
+    ) -> Estimate<T, N> {
+        let s = self.params.initial_velocity_sigma;
+        let p = Blocks::diagonal(self.params.measurement, SMatrix::identity() * (s * s));
+        report.outliers = self.screen.accept();
+        (self.t, self.q, self.v, self.p) = (t, q, v, p);
+        (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
+        Self::estimate(self)
     }
 }
