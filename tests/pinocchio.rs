@@ -2,7 +2,9 @@
 //! model written inline),
 //! `tests/robots/panda.yaml` (URDFs from example-robot-data, shipped in
 //! `tests/robots/urdf/`), `tests/robots/slider_arm.yaml` and
-//! `tests/robots/serial_12.yaml` (URDFs written for the tests) compiled by `model!`, compared with the values that
+//! `tests/robots/serial_12.yaml` (URDFs written for the tests) and
+//! `tests/robots/go1.yaml` (Unitree Go1's legs, example-robot-data) compiled
+//! by `model!`, compared with the values that
 //! `tests/pinocchio_reference.py` wrote with Pinocchio at 8 seeded
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
 //! matrix (Pinocchio's CRBA), `F = C v + G` (its nonlinear effects), `G`,
@@ -10,7 +12,9 @@
 //! the constraints `h` and `J`), and that `C` is the Christoffel one
 //! (`C(v) w = C(w) v`, with `C(v) v` Pinocchio's), every entry to 1e-10
 //! relative (to the largest entry of the same quantity at the same
-//! configuration). For two of the robots, the derivatives built from the
+//! configuration); Pinocchio's joints are taken in the model's order (they
+//! differ where a link has several children, Go1's trunk). For three of the
+//! robots, the derivatives built from the
 //! recursions (`∂F/∂q`, `∂F/∂v`, `∂(M v)/∂q`, `∂(J v)/∂q`) against central
 //! differences, and `Ṁ − 2C` skew-symmetric.
 
@@ -26,6 +30,7 @@ moreau::model!(file = "tests/robots/ur5.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
 moreau::model!(file = "tests/robots/slider_arm.yaml");
 moreau::model!(file = "tests/robots/serial_12.yaml");
+moreau::model!(file = "tests/robots/go1.yaml");
 
 /// `tests/robots/ur5.yaml` written inline, the URDF named by `urdf = "...";`.
 mod inline {
@@ -82,36 +87,78 @@ fn rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f64, R, C>) -> Vec
     m.transpose().as_slice().to_vec()
 }
 
-/// The points of the fixtures are read through the constraints: the first
-/// three give `1 − x`, `1 − y`, `z + 0.5` of the first point, the next three
-/// those of the second.
-fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize>(
-    model: &M,
-    robot: &str,
-    joints: [&str; N],
-) {
-    let data = fixture(robot);
-    let names: Vec<&str> = data["joints"]
+/// Where each of the model's coordinates `joints` (the URDF's moving joints,
+/// depth first, a link's children in the order of the file) is in the
+/// fixture's, Pinocchio's, order (depth first too, but a link's children in
+/// the order of their joints' names: urdfdom keeps the joints in a sorted
+/// map). The two orders are the same joints.
+fn pinocchio_order<const N: usize>(data: &Value, joints: [&str; N]) -> [usize; N] {
+    let mut names: Vec<&str> = data["joints"]
         .as_array()
         .unwrap()
         .iter()
         .map(|j| j.as_str().unwrap())
         .collect();
+    let order = joints.map(|j| {
+        names
+            .iter()
+            .position(|n| *n == j)
+            .unwrap_or_else(|| panic!("`{j}` is not one of Pinocchio's joints {names:?}"))
+    });
+    let mut ours = joints.to_vec();
+    ours.sort_unstable();
+    names.sort_unstable();
+    assert_eq!(ours, names, "the same joints as Pinocchio's");
+    order
+}
+
+/// The entries `(rows[i], cols[j])` of a row-major matrix with `n`
+/// columns, row-major.
+fn pick(m: &[f64], n: usize, rows: &[usize], cols: &[usize]) -> Vec<f64> {
+    rows.iter()
+        .flat_map(|r| cols.iter().map(move |c| m[r * n + c]))
+        .collect()
+}
+
+/// A fixture's sample `q`, `v` in the model's order.
+fn state<const N: usize>(s: &Value, order: &[usize; N]) -> (SVector<f64, N>, SVector<f64, N>) {
+    let (q, v) = (numbers(&s["q"]), numbers(&s["v"]));
+    (
+        SVector::from_fn(|i, _| q[order[i]]),
+        SVector::from_fn(|i, _| v[order[i]]),
+    )
+}
+
+/// The points of the fixtures are read through the constraints: the first
+/// three give `1 − x`, `1 − y`, `z + floor` of the first point, the next
+/// three those of the second. `joints` are the model's coordinates, in its
+/// order; Pinocchio's values are taken in that order.
+fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize>(
+    model: &M,
+    robot: &str,
+    joints: [&str; N],
+    floor: f64,
+) {
+    let data = fixture(robot);
     assert_eq!(
-        names, joints,
-        "the coordinates are Pinocchio's joints, in its order"
+        M::INFO.coordinates,
+        joints,
+        "the coordinates are the URDF's moving joints"
     );
+    let order = pinocchio_order(&data, joints);
     let samples = data["samples"].as_array().expect("samples");
     assert_eq!(samples.len(), 8);
     let mut worst = 0.0_f64;
     for (k, s) in samples.iter().enumerate() {
-        let q = SVector::<f64, N>::from_iterator(numbers(&s["q"]));
-        let v = SVector::<f64, N>::from_iterator(numbers(&s["v"]));
+        let (q, v) = state(s, &order);
         let u = SVector::<f64, 0>::zeros();
         let at = |what: &str| format!("{robot} sample {k}: {what}");
-        worst = worst.max(agree(&rows(&model.mass(&q)), &numbers(&s["M"]), &at("M")));
+        let mass = pick(&numbers(&s["M"]), N, &order, &order);
+        worst = worst.max(agree(&rows(&model.mass(&q)), &mass, &at("M")));
+        let nle = pick(&numbers(&s["nle"]), N, &[0], &order);
+        let gravity = pick(&numbers(&s["G"]), N, &[0], &order);
         let f = model.forces(0.0, &q, &v, &u);
-        worst = worst.max(agree(f.as_slice(), &numbers(&s["nle"]), &at("C v + G")));
+        worst = worst.max(agree(f.as_slice(), &nle, &at("C v + G")));
         let cv = model.coriolis(&q, &v) * v;
         // The Christoffel C is the one with C(v) w = C(w) v (Γ_ijk
         // symmetric in j, k) and C(v) v the velocity terms.
@@ -123,22 +170,14 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
             cwv.as_slice(),
             &at("C(v) w = C(w) v"),
         ));
-        let cv_ref: Vec<f64> = numbers(&s["nle"])
-            .iter()
-            .zip(numbers(&s["G"]))
-            .map(|(n, g)| n - g)
-            .collect();
+        let cv_ref: Vec<f64> = nle.iter().zip(&gravity).map(|(n, g)| n - g).collect();
         worst = worst.max(agree(cv.as_slice(), &cv_ref, &at("C v")));
-        worst = worst.max(agree(
-            model.gravity(&q).as_slice(),
-            &numbers(&s["G"]),
-            &at("G"),
-        ));
+        worst = worst.max(agree(model.gravity(&q).as_slice(), &gravity, &at("G")));
         let h = model.gaps(&q);
         let j = model.gap_jacobian(&q);
         for (p, point) in s["points"].as_array().unwrap().iter().enumerate() {
             let r = 3 * p;
-            let position = [1.0 - h[r], 1.0 - h[r + 1], h[r + 2] - 0.5];
+            let position = [1.0 - h[r], 1.0 - h[r + 1], h[r + 2] - floor];
             worst = worst.max(agree(
                 &position,
                 &numbers(&point["position"]),
@@ -148,11 +187,8 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
             for (row, sign) in [(r, -1.0), (r + 1, -1.0), (r + 2, 1.0)] {
                 jac.extend((0..N).map(|c| sign * j[(row, c)]));
             }
-            worst = worst.max(agree(
-                &jac,
-                &numbers(&point["jacobian"]),
-                &at("point Jacobian"),
-            ));
+            let reference = pick(&numbers(&point["jacobian"]), N, &[0, 1, 2], &order);
+            worst = worst.max(agree(&jac, &reference, &at("point Jacobian")));
         }
     }
     println!(
@@ -172,13 +208,13 @@ const UR5_JOINTS: [&str; 6] = [
 
 #[test]
 fn ur5_matches_pinocchio() {
-    compare(&Ur5::<f64>::new(), "ur5", UR5_JOINTS);
+    compare(&Ur5::<f64>::new(), "ur5", UR5_JOINTS, 0.5);
 }
 
 /// The same URDF through the inline front end.
 #[test]
 fn inline_ur5_matches_pinocchio() {
-    compare(&inline::Ur5::<f64>::new(), "ur5", UR5_JOINTS);
+    compare(&inline::Ur5::<f64>::new(), "ur5", UR5_JOINTS, 0.5);
 }
 
 #[test]
@@ -195,6 +231,7 @@ fn panda_matches_pinocchio() {
             "panda_joint6",
             "panda_joint7",
         ],
+        0.5,
     );
 }
 
@@ -207,6 +244,7 @@ fn slider_arm_matches_pinocchio() {
         &SliderArm::<f64>::new(),
         "slider_arm",
         ["slide", "shoulder", "elbow", "side_slide"],
+        0.5,
     );
 }
 
@@ -220,7 +258,33 @@ fn serial_12_matches_pinocchio() {
         [
             "j1", "j2", "j3", "j4", "j5", "j6", "j7", "j8", "j9", "j10", "j11", "j12",
         ],
+        0.5,
     );
+}
+
+/// The coordinates of `tests/robots/go1.yaml`: the legs in the URDF's order
+/// (FR, FL, RR, RL), which Pinocchio's (FL, FR, RL, RR) permutes.
+const GO1_JOINTS: [&str; 12] = [
+    "FR_hip_joint",
+    "FR_thigh_joint",
+    "FR_calf_joint",
+    "FL_hip_joint",
+    "FL_thigh_joint",
+    "FL_calf_joint",
+    "RR_hip_joint",
+    "RR_thigh_joint",
+    "RR_calf_joint",
+    "RL_hip_joint",
+    "RL_thigh_joint",
+    "RL_calf_joint",
+];
+
+/// Unitree Go1's 12 leg joints with the trunk fixed (example-robot-data's
+/// URDF: fixed rotor, IMU and foot links, branches at the trunk); the feet's
+/// centres above a ground 0.4 m down, less their radius 0.02.
+#[test]
+fn go1_matches_pinocchio() {
+    compare(&Go1::<f64>::new(), "go1", GO1_JOINTS, 0.4 - 0.02);
 }
 
 #[test]
@@ -241,10 +305,10 @@ where
     M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>> + Sensitivities<N, 6>,
 {
     let data = fixture(robot);
+    let order = pinocchio_order(&data, M::INFO.coordinates);
     let u = SVector::<f64, 0>::zeros();
     for (k, s) in data["samples"].as_array().unwrap().iter().enumerate() {
-        let q = SVector::<f64, N>::from_iterator(numbers(&s["q"]));
-        let v = SVector::<f64, N>::from_iterator(numbers(&s["v"]));
+        let (q, v) = state(s, &order);
         let lin = model.linearization(0.0, &q, &v, &u);
         let mass_dq = model.mass_dq(&q, &v);
         let jacobian_dq = model.jacobian_dq(&q, &v);
@@ -295,4 +359,9 @@ fn slider_arm_derivatives_match_finite_differences() {
 #[test]
 fn serial_12_derivatives_match_finite_differences() {
     derivatives_match_finite_differences(&Serial12::<f64>::new(), "serial_12");
+}
+
+#[test]
+fn go1_derivatives_match_finite_differences() {
+    derivatives_match_finite_differences(&Go1::<f64>::new(), "go1");
 }

@@ -79,6 +79,13 @@ ROBOTS = [
         [],
         [("l12", [0.02, -0.01, 0.1]), ("l6", [0.0, 0.0, 0.0])],
     ),
+    (
+        "go1",
+        "tests/robots/urdf/go1_description/go1.urdf",
+        "go1_description/urdf/go1.urdf",
+        [],
+        [("FR_foot", [0.0, 0.0, 0.0]), ("RL_foot", [0.0, 0.0, 0.0])],
+    ),
 ]
 
 

@@ -1,6 +1,7 @@
 //! moreau's generated `M` and `C v + G` beside Pinocchio's C++ (CRBA and
 //! nonlinear effects), interleaved in one process, for the UR5, the Panda
-//! (fingers locked) and the generated 12-joint chain.
+//! (fingers locked), Unitree Go1's legs (fixed trunk) and the generated
+//! 12-joint chain.
 //!
 //! How each side is called:
 //!
@@ -15,7 +16,9 @@
 //!
 //! Inputs vary over 32 seeded points (`q` in [−π, π], `v` in [−2, 2]), and
 //! both sides are checked to agree at every point (1e-10 relative to the
-//! largest entry) before timing. One sample is 16 passes over the points
+//! largest entry) before timing. Pinocchio gets the same points in its
+//! order of the joints (a link's children sorted by joint name, where
+//! moreau keeps the URDF's order: Go1's legs), permuted before timing. One sample is 16 passes over the points
 //! (512 calls) of one side; the sides are sampled in turn, in alternating
 //! order, `REPS` times (`MOREAU_BENCH_REPS`, default 301). The table gives
 //! the minimum and median time per call of each side and the ratio
@@ -39,6 +42,7 @@ mod run {
     moreau::model!(file = "robots/ur5.yaml");
     moreau::model!(file = "robots/panda.yaml");
     moreau::model!(file = "robots/serial_12.yaml");
+    moreau::model!(file = "robots/go1.yaml");
 
     const PASSES: usize = 16;
     const POINTS: usize = 32;
@@ -71,6 +75,21 @@ mod run {
         M: Model<N, 0, Scalar = f64, Input = SVector<f64, 0>>,
     {
         assert_eq!(robot.nv(), N, "{name}: coordinates");
+        // Moreau's coordinate i is Pinocchio's order[i].
+        let order: [usize; N] = M::INFO.coordinates.map(|c| {
+            robot
+                .joints()
+                .iter()
+                .position(|j| j == c)
+                .unwrap_or_else(|| panic!("{name}: `{c}` is not one of Pinocchio's joints"))
+        });
+        let pinocchio_order = |x: &SVector<f64, N>| {
+            let mut out = vec![0.0; N];
+            for (i, &k) in order.iter().enumerate() {
+                out[k] = x[i];
+            }
+            out
+        };
         let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
         let q: Vec<SVector<f64, N>> = (0..POINTS)
             .map(|_| SVector::from_fn(|_, _| std::f64::consts::PI * uniform(&mut seed)))
@@ -78,12 +97,18 @@ mod run {
         let v: Vec<SVector<f64, N>> = (0..POINTS)
             .map(|_| SVector::from_fn(|_, _| 2.0 * uniform(&mut seed)))
             .collect();
+        let q_pin: Vec<Vec<f64>> = q.iter().map(pinocchio_order).collect();
+        let v_pin: Vec<Vec<f64>> = v.iter().map(pinocchio_order).collect();
         let u = SVector::<f64, 0>::zeros();
         let mut mass = vec![0.0; N * N];
         let mut nle = vec![0.0; N];
         for k in 0..POINTS {
             let (m, f) = model.dynamics(0.0, &q[k], &v[k], &u);
-            robot.crba_nle(q[k].as_slice(), v[k].as_slice(), &mut mass, &mut nle);
+            robot.crba_nle(&q_pin[k], &v_pin[k], &mut mass, &mut nle);
+            let mass: Vec<f64> = (0..N * N)
+                .map(|e| mass[order[e / N] * N + order[e % N]])
+                .collect();
+            let nle: Vec<f64> = order.iter().map(|&i| nle[i]).collect();
             agree(m.as_slice(), &mass, &format!("{name} point {k}: M"));
             agree(f.as_slice(), &nle, &format!("{name} point {k}: C v + G"));
         }
@@ -103,7 +128,7 @@ mod run {
                             let r = black_box(&model).dynamics(0.0, &q[k], &v[k], &u);
                             black_box(&r);
                         } else {
-                            robot.crba_nle(q[k].as_slice(), v[k].as_slice(), &mut mass, &mut nle);
+                            robot.crba_nle(&q_pin[k], &v_pin[k], &mut mass, &mut nle);
                             black_box(&mass);
                             black_box(&nle);
                         }
@@ -131,6 +156,10 @@ mod run {
                 include_bytes!("../../tests/robots/urdf/panda_description/panda.urdf"),
             ),
             (
+                include_bytes!("../robots/go1.urdf"),
+                include_bytes!("../../tests/robots/urdf/go1_description/go1.urdf"),
+            ),
+            (
                 include_bytes!("../robots/serial_12.urdf"),
                 include_bytes!("../../tests/robots/urdf/synthetic/serial/serial_12.urdf"),
             ),
@@ -146,6 +175,11 @@ mod run {
         println!("|---|---:|---:|---:|---:|");
         compare("UR5", Ur5::<f64>::new(), Robot::load("ur5"));
         compare("Panda", Panda::<f64>::new(), Robot::load("panda"));
+        compare(
+            "Go1 (legs, trunk fixed)",
+            Go1::<f64>::new(),
+            Robot::load("go1"),
+        );
         compare(
             "12-joint chain",
             Serial12::<f64>::new(),

@@ -206,13 +206,15 @@ pub mod pinocchio {
     pub struct Robot {
         handle: *mut c_void,
         nv: usize,
+        joints: Vec<String>,
     }
 
     impl Robot {
-        /// The robot saved as `name` (`ur5`, `panda`, `serial_12`).
+        /// The robot saved as `name` (`ur5`, `panda`, `serial_12`, `go1`),
+        /// with its joints' names (`OUT_DIR/<name>.joints`).
         ///
         /// # Panics
-        /// If the archive is missing or cannot be loaded.
+        /// If the archive or the names are missing or cannot be loaded.
         #[must_use]
         pub fn load(name: &str) -> Robot {
             let path = format!("{}/{name}.txt", env!("OUT_DIR"));
@@ -222,7 +224,20 @@ pub mod pinocchio {
             assert!(!handle.is_null(), "Pinocchio cannot load {path}");
             // SAFETY: a live handle.
             let nv = usize::try_from(unsafe { moreau_pin_nv(handle) }).expect("nv ≥ 0");
-            Robot { handle, nv }
+            let names = format!("{}/{name}.joints", env!("OUT_DIR"));
+            let joints: Vec<String> = std::fs::read_to_string(&names)
+                .unwrap_or_else(|e| panic!("cannot read {names}: {e}"))
+                .lines()
+                .map(str::to_string)
+                .collect();
+            assert_eq!(joints.len(), nv, "{names}: one joint per coordinate");
+            Robot { handle, nv, joints }
+        }
+
+        /// The joints' names, in the order of Pinocchio's coordinates.
+        #[must_use]
+        pub fn joints(&self) -> &[String] {
+            &self.joints
         }
 
         /// The number of coordinates.

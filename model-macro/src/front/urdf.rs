@@ -11,7 +11,9 @@
 //!   whose child it is: `revolute` and `continuous` become revolute joints,
 //!   `prismatic` prismatic, `fixed` fixed; the joint's `<origin>` is the
 //!   body's `xyz` and `rpy`, its `<axis>` (default `1 0 0`) the axis, its
-//!   name the coordinate's (the velocity is `d<name>`);
+//!   name the coordinate's (the velocity is `d<name>`), the coordinates in
+//!   the depth-first order of the tree, a link's children in the order of
+//!   the file (Pinocchio, through urdfdom, sorts them by joint name);
 //! - the link's `<inertial>`: `mass`, `origin xyz` as the centre of mass and
 //!   the inertia rotated by `origin rpy` into the link's frame
 //!   (`R I Rᵀ`), computed here in `f64`;
