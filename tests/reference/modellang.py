@@ -788,14 +788,17 @@ def build_casadi(model: Model) -> CasadiModel:
     T_tree = V_tree = ca.SX(0)
     if model.bodies:
         grav = model.gravity or [("num", 0.0), ("num", 0.0), ("num", -9.81)]
-        tree = build_tree(
-            model.bodies,
-            ca.vertcat(*[_to_sx(x, env, ca) for x in grav]),
-            q,
-            v,
-            lambda node: _to_sx(node, env, ca),
-            ca,
-        )
+        try:
+            tree = build_tree(
+                model.bodies,
+                ca.vertcat(*[_to_sx(x, env, ca) for x in grav]),
+                q,
+                v,
+                lambda node: _to_sx(node, env, ca),
+                ca,
+            )
+        except UrdfError as exc:
+            raise ModelError(f"{model.name}: {exc}") from None
         env["@frames"] = tree.frames
         T_tree, V_tree = tree.T, tree.V
     for nm in model.definitions:

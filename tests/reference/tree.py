@@ -75,7 +75,7 @@ class Urdf:
 
 
 class UrdfError(ValueError):
-    pass
+    """A URDF or a tree that cannot be read (the caller adds where)."""
 
 
 def _num(x: float):
@@ -93,6 +93,15 @@ def _floats(elem, key: str, default: list[float], where: str) -> list[float]:
     if len(vals) != len(default) or not all(math.isfinite(x) for x in vals):
         raise UrdfError(f"{where}: {key}={text!r} is not {len(default)} finite number(s)")
     return vals
+
+
+def _link(joint, end: str, path) -> str:
+    """The link named by a joint's ``<parent>`` or ``<child>``."""
+    elem = joint.find(end)
+    name = None if elem is None else elem.get("link")
+    if name is None:
+        raise UrdfError(f"{path}: joint `{joint.get('name')}` has no <{end} link=...>")
+    return name
 
 
 def read_urdf(path: Path, locked: list[str], first_coordinate: int) -> Urdf:
@@ -115,8 +124,10 @@ def read_urdf(path: Path, locked: list[str], first_coordinate: int) -> Urdf:
     children: dict[str, list[ET.Element]] = {}
     child_links = set()
     for j in joints:
-        parent = j.find("parent").get("link")
-        child = j.find("child").get("link")
+        parent, child = (_link(j, end, path) for end in ("parent", "child"))
+        for link in (parent, child):
+            if link not in links:
+                raise UrdfError(f"{path}: joint `{j.get('name')}` names no link `{link}`")
         if child in child_links:
             raise UrdfError(f"{path}: link `{child}` is the child of two joints")
         child_links.add(child)
@@ -155,7 +166,7 @@ def read_urdf(path: Path, locked: list[str], first_coordinate: int) -> Urdf:
             lim = j.find("limit")
             if lim is not None and lim.get("lower") is not None and lim.get("upper") is not None:
                 out.limits[name] = (float(lim.get("lower")), float(lim.get("upper")))
-        child = j.find("child").get("link")
+        child = _link(j, "child", path)
         inertial = links[child].find("inertial")
         mass, com, rpy_in, inertia = 0.0, [0.0] * 3, [0.0] * 3, [0.0] * 6
         if inertial is not None:
@@ -242,7 +253,9 @@ def build_tree(bodies: list[Body], gravity, q, v, number, ca) -> TreeSX:
         if name in frames:
             return frames[name]
         if name in seen:
-            raise ValueError(f"the bodies form a cycle through `{name}`")
+            raise UrdfError(f"the bodies form a cycle through `{name}`")
+        if name not in by_name:
+            raise UrdfError(f"`{name}` is not a body")
         b = by_name[name]
         if b.parent is None:
             r0, p0 = ca.SX.eye(3), ca.SX.zeros(3, 1)
