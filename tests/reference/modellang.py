@@ -586,7 +586,8 @@ def _validate(doc, crate_dir: Path) -> Model:
         if default_e is None:
             raise ModelError("limits: the limits' constraints take the top-level `restitution`")
         lower, upper = limits[joint]
-        for suffix, text in (("lower", f"{joint} - ({lower!r})"), ("upper", f"({upper!r}) - {joint}")):
+        bounds = (("lower", f"{joint} - ({lower!r})"), ("upper", f"({upper!r}) - {joint}"))
+        for suffix, text in bounds:
             cn = f"{joint}_{suffix}"
             constraints.append(Constraint(cn, expr(("constraint", cn), text, cn), default_e))
 
@@ -650,7 +651,9 @@ def _bodies(raw, coordinates: list[str], velocities: list[str]) -> list:
     for i, b in enumerate(raw):
         where = f"bodies[{i}]"
         if not isinstance(b, dict) or set(b) - _BODY_KEYS or not {"name", "joint", "mass"} <= set(b):
-            raise ModelError(f"{where}: a body has name, joint, mass and optionally parent, com, inertia")
+            raise ModelError(
+                f"{where}: a body has name, joint, mass and optionally parent, com, inertia"
+            )
         j = b["joint"]
         if not isinstance(j, dict) or set(j) - _JOINT_KEYS or j.get("type") not in JOINT_TYPES:
             raise ModelError(f"{where}.joint: a joint has a type ({', '.join(JOINT_TYPES)}) "
