@@ -650,7 +650,8 @@ def _bodies(raw, coordinates: list[str], velocities: list[str]) -> list:
     zero = ("num", 0.0)
     for i, b in enumerate(raw):
         where = f"bodies[{i}]"
-        if not isinstance(b, dict) or set(b) - _BODY_KEYS or not {"name", "joint", "mass"} <= set(b):
+        required = {"name", "joint", "mass"}
+        if not isinstance(b, dict) or set(b) - _BODY_KEYS or not required <= set(b):
             raise ModelError(
                 f"{where}: a body has name, joint, mass and optionally parent, com, inertia"
             )
