@@ -12,6 +12,16 @@ parameters ``p``, and computes with CasADi's own differentiation:
 * ``G = ∂V/∂q``, ``F = C v + G − Q`` (``Q`` from ``applied``, 0 where missing),
 * ``h`` and ``J = ∂h/∂q`` (row ``i`` is ``∇h_iᵀ``).
 
+A kinematic tree (``bodies``, or ``urdf`` with ``locked`` and ``limits``:
+the robots of ``tests/robots/``) goes the same way, by the Lagrangian route:
+``tests/reference/tree.py`` reads the URDF with ``xml.etree``, poses each
+body by the chain of its joints' transforms and writes its kinetic and
+potential energies (``Σ ½ m |ċ|² + ½ ω_bᵀ I ω_b``, ``−Σ m gᵀ c``); moreau
+builds the same quantities by recursions instead (composite rigid bodies,
+Newton–Euler). For a tree, ``∂F/∂q`` and ``∂F/∂v`` are taken of Lagrange's
+form of ``F`` (checked equal to the Christoffel form below), whose graph is
+far smaller.
+
 Internal checks at every sample point (the script fails if one does not hold):
 
 * Lagrange's equations: ``F = (∂²T/∂v∂q) v − ∂T/∂q + G − Q`` to 1e-12
@@ -70,12 +80,31 @@ JSON schema (keys sorted; floats written with ``repr``, so they round-trip)::
       ]
     }
 
+With ``--no-c`` only the JSON is written, without CSE and without the
+four keys of CasADi's operation counts and C function (``c_function``,
+``casadi_n_instructions``, ``casadi_op_count``, ``casadi_op_kinds``): the
+robots' fixtures (``tests/fixtures/casadi/robots/``), whose Lagrangian
+graphs are large (the 12-joint chain's fused Function has millions of
+instructions) and whose op counts are not compared.
+
+``--agree A B`` writes nothing: it evaluates models A and B (the same
+coordinates, inputs and constraints; B's parameters taken by name from A's
+point, B's defaults for the others) at A's sample points and requires every
+output to agree to 1e-12 relative to the largest entry of A's (for ``C``,
+``∂F/∂v`` and ``∂(M v)/∂q``, sums of ``(∂M/∂q) v`` whose terms cancel where
+``M`` is stationary, at least ``max|M| max|v|``): the two-link tree of
+``tests/robots/two_link.yaml`` against its energies written by hand.
+
 Usage::
 
     python tests/casadi_reference.py            # regenerate all models
     python tests/casadi_reference.py --check    # compare with the committed files
     python tests/casadi_reference.py --model my_model.yaml --out DIR
     python tests/casadi_reference.py --model my_model.yaml --out DIR --check
+    python tests/casadi_reference.py $(printf -- '--model %s ' tests/robots/*.yaml) \\
+        --out tests/fixtures/casadi/robots --no-c [--check]
+    python tests/casadi_reference.py --agree tests/robots/two_link.yaml \\
+        tests/robots/two_link_energies.yaml
 
 ``--check`` regenerates into a temporary directory and compares with the
 files in place: the JSON structure (keys, list lengths, strings, integers)
@@ -121,6 +150,7 @@ N_DEFAULT_POINTS = 4
 LAGRANGE_RTOL = 1e-12
 CHECK_ULPS = 4
 CHECK_RTOL = 1e-14
+AGREE_RTOL = 1e-12
 
 MODELS_DIR = REPO / "models"
 FIXTURES_DIR = REPO / "tests" / "fixtures" / "casadi"
@@ -139,8 +169,10 @@ def c_name(stem: str) -> str:
     return name
 
 
-def build(model: Model, cname: str):
-    """Return (fused Function, check Function)."""
+def build(model: Model, cname: str, cse: bool = True):
+    """Return (fused Function, check Function). ``cse``: the fused Function
+    is built with CasADi's common-subexpression elimination (what its
+    operation count and C code are taken from)."""
     import casadi as ca
 
     cm = build_casadi(model)
@@ -176,7 +208,7 @@ def build(model: Model, cname: str):
         outs,
         ["t", "q", "v", "u", "p"],
         ["M", "C", "G", "F", "h", "J"],
-        {"cse": True},
+        {"cse": cse},
     )
 
     # Independent check: Lagrange's equations, Ṁ - 2C skew, homogeneity of T.
@@ -192,8 +224,13 @@ def build(model: Model, cname: str):
     dTdv0 = ca.substitute(dTdv, v, zero_v)
     terms = ca.horzcat(Cv, G, cm.Q, Tqv_v, dTdq)
     # The force Jacobians ∂F/∂q and ∂F/∂v (what an implicit Moreau–Jean step
-    # puts in its iteration matrix); not part of the fused op count.
-    dF = (ca.jacobian(F, q), ca.jacobian(F, v))
+    # puts in its iteration matrix); not part of the fused op count. A
+    # tree's are taken of Lagrange's form of F (equal to the Christoffel form
+    # to 1e-12, checked below), whose graph is far smaller than that of the
+    # n³ Christoffel symbols: the 12-joint chain's Christoffel form took
+    # minutes and gigabytes.
+    f_diff = F_lag if model.bodies else F
+    dF = (ca.jacobian(f_diff, q), ca.jacobian(f_diff, v))
     # What a covariance-propagating estimator needs: ∂(M v)/∂q and ∂(J v)/∂q
     # at fixed v (CasADi's AD of the products).
     dMv = ca.jacobian(ca.mtimes(M, v), q)
@@ -363,25 +400,30 @@ def dump_json(obj) -> str:
     return "\n".join(lines) + "\n"
 
 
-def generate(model_path: Path, json_dir: Path, c_dir: Path, n_points: int):
-    """Generate the JSON and the C files for one model; return their paths."""
+def generate(model_path: Path, json_dir: Path, c_dir: Path | None, n_points: int):
+    """Generate the JSON and (unless ``c_dir`` is None) the C files for one
+    model; return their paths."""
     import casadi as ca
 
     model_path = Path(model_path)
     stem = model_path.stem
     cname = c_name(stem)
     model = load_model(model_path)
-    fused, check = build(model, cname)
-    n_instr, n_ops, kinds = op_counts(fused)
+    fused, check = build(model, cname, cse=c_dir is not None)
     seed = seed_for(stem)
     pts = sample_points(model, seed, n_points)
     pts = evaluate(model, fused, check, pts, model_path.name)
 
-    data = {
-        "c_function": fused.name(),
-        "casadi_n_instructions": n_instr,
-        "casadi_op_count": n_ops,
-        "casadi_op_kinds": kinds,
+    data = {}
+    if c_dir is not None:
+        n_instr, n_ops, kinds = op_counts(fused)
+        data = {
+            "c_function": fused.name(),
+            "casadi_n_instructions": n_instr,
+            "casadi_op_count": n_ops,
+            "casadi_op_kinds": kinds,
+        }
+    data |= {
         "casadi_version": ca.__version__,
         "constraints": [c.name for c in model.constraints],
         "coordinates": list(model.coordinates),
@@ -400,10 +442,12 @@ def generate(model_path: Path, json_dir: Path, c_dir: Path, n_points: int):
         "velocities": list(model.velocities),
     }
     json_dir.mkdir(parents=True, exist_ok=True)
-    c_dir.mkdir(parents=True, exist_ok=True)
     json_path = json_dir / f"{stem}.json"
     json_path.write_text(dump_json(data), encoding="utf-8")
+    if c_dir is None:
+        return [json_path], data
 
+    c_dir.mkdir(parents=True, exist_ok=True)
     cg = ca.CodeGenerator(f"{cname}.c", {"with_header": True})
     cg.add(fused)
     cg.generate(str(c_dir) + os.sep)
@@ -547,6 +591,18 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--points", type=int, default=N_POINTS, help=f"sample points (default {N_POINTS})"
     )
+    ap.add_argument(
+        "--no-c",
+        action="store_true",
+        help="write the JSON only, without the operation counts (no C code, no CSE)",
+    )
+    ap.add_argument(
+        "--agree",
+        nargs=2,
+        metavar=("A", "B"),
+        help="check that two model files are the same model (every output to "
+        f"{AGREE_RTOL:g} at A's sample points); writes nothing",
+    )
     args = ap.parse_args(argv)
 
     try:
@@ -569,6 +625,12 @@ def main(argv=None) -> int:
 
     if args.points < N_DEFAULT_POINTS:
         ap.error(f"--points must be at least {N_DEFAULT_POINTS}")
+    if args.agree:
+        try:
+            return agree(*(Path(m) for m in args.agree), args.points)
+        except (ModelError, OSError) as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
     if args.model:
         models = [Path(m) for m in args.model]
         for m in models:
@@ -589,22 +651,28 @@ def main(argv=None) -> int:
         json_dir = c_dir = Path(args.out)
     else:
         json_dir, c_dir = FIXTURES_DIR, BENCH_DIR
+    if args.no_c:
+        c_dir = None
 
     try:
         if not args.check:
             for m in models:
                 paths, data = generate(m, json_dir, c_dir, args.points)
-                print(
-                    f"{m.name}: {data['model']} N={data['n']} K={data['k']} "
+                counts = (
                     f"op_count={data['casadi_op_count']} "
-                    f"n_instructions={data['casadi_n_instructions']} -> "
+                    f"n_instructions={data['casadi_n_instructions']} "
+                    if "casadi_op_count" in data
+                    else ""
+                )
+                print(
+                    f"{m.name}: {data['model']} N={data['n']} K={data['k']} {counts}-> "
                     + ", ".join(_rel(p) for p in paths)
                 )
             return 0
 
         with tempfile.TemporaryDirectory(prefix="casadi-ref-") as tmp:
             tmp_json = Path(tmp) / "json"
-            tmp_c = Path(tmp) / "c"
+            tmp_c = None if c_dir is None else Path(tmp) / "c"
             pairs = []
             for m in models:
                 paths, _ = generate(m, tmp_json, tmp_c, args.points)
@@ -613,7 +681,9 @@ def main(argv=None) -> int:
                     pairs.append((dest, p))
             extra = []
             if not args.model and not args.out:
-                extra = [(json_dir, "*.json"), (c_dir, "*.c"), (c_dir, "*.h")]
+                extra = [(json_dir, "*.json")]
+                if c_dir is not None:
+                    extra += [(c_dir, "*.c"), (c_dir, "*.h")]
             diffs = check_files(pairs, extra)
     except ModelError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -629,6 +699,56 @@ def main(argv=None) -> int:
             print(f"  {d}", file=sys.stderr)
         return 1
     print(f"casadi_reference --check: {len(pairs)} files match ({len(models)} models)")
+    return 0
+
+
+def agree(path_a: Path, path_b: Path, n_points: int) -> int:
+    """Model B against model A at A's sample points: the same coordinates in
+    the same order, B's parameters by name from A's point (B's default for a
+    parameter A does not have), the same constraints; every output M, C, G,
+    F, h, J, ∂F/∂q, ∂F/∂v, ∂(M v)/∂q, ∂(J v)/∂q to AGREE_RTOL relative to
+    the largest entry of A's (for C, ∂F/∂v and ∂(M v)/∂q, sums of (∂M/∂q) v
+    whose terms cancel where M is stationary, at least max|M| max|v|). 0
+    when they agree, 1 otherwise."""
+    import numpy as np
+
+    ma, mb = load_model(path_a), load_model(path_b)
+    if (ma.coordinates, ma.velocities) != (mb.coordinates, mb.velocities):
+        raise ModelError(f"{path_a} and {path_b} have different coordinates")
+    if [c.name for c in ma.constraints] != [c.name for c in mb.constraints]:
+        raise ModelError(f"{path_a} and {path_b} have different constraints")
+    if ma.inputs != mb.inputs:
+        raise ModelError(f"{path_a} and {path_b} have different inputs")
+    fa, ca_ = build(ma, "a", cse=False)
+    fb, cb = build(mb, "b", cse=False)
+    pts = evaluate(ma, fa, ca_, sample_points(ma, seed_for(path_a.stem), n_points), path_a.name)
+    names_a = list(ma.parameters)
+    bad, worst = [], {}
+    for idx, pt in enumerate(pts):
+        pb = [
+            pt["p"][names_a.index(nm)] if nm in names_a else default
+            for nm, default in mb.parameters.items()
+        ]
+        other = {k: pt[k] for k in ("t", "q", "v", "u")}
+        other["p"] = pb
+        (other,) = evaluate(mb, fb, cb, [other], path_b.name)
+        for key in ("M", "C", "G", "F", "h", "J", "dFdq", "dFdv", "dMvdq", "dJvdq"):
+            a, b = np.array(pt[key], dtype=float), np.array(other[key], dtype=float)
+            scale = float(np.max(np.abs(a), initial=0.0))
+            if key in ("C", "dFdv", "dMvdq"):
+                # sums of (∂M/∂q) v, whose terms cancel where M is stationary
+                scale = max(scale, float(np.max(np.abs(pt["M"]))) * float(np.max(np.abs(pt["v"]))))
+            err = float(np.max(np.abs(a - b), initial=0.0)) / scale if scale > 0 else 0.0
+            worst[key] = max(worst.get(key, 0.0), err)
+            if not err <= AGREE_RTOL:
+                bad.append(f"point {idx}: {key} differs by {err:.3e} (relative)")
+    print(
+        f"casadi_reference --agree {path_a.name} {path_b.name}: largest relative difference "
+        + ", ".join(f"{k} {v:.1e}" for k, v in worst.items())
+    )
+    if bad:
+        print("  " + "\n  ".join(bad[:20]), file=sys.stderr)
+        return 1
     return 0
 
 

@@ -5,127 +5,21 @@
 //!    G, F, h, J, ∂F/∂q and ∂F/∂v at 32 seeded points per model (the first
 //!    four at the default parameters, the others with every parameter scaled
 //!    by a random factor in [0.5, 1.5]). Every generated method must agree to
-//!    1e-12, relative as `common::relative_error` defines it.
+//!    1e-12, relative as `common::relative_error` defines it (for C, ∂F/∂v
+//!    and ∂(M v)/∂q, sums of (∂M/∂q) v, to a scale of at least
+//!    max|M| max|v|; `common::casadi::against_casadi`). The robots of
+//!    `tests/robots/` go through the same comparison in `tests/robots_casadi.rs`.
 //! 2. What needs no CasADi: M symmetric positive definite, the skew
 //!    symmetry of Ṁ − 2C (property (P1)), J and the force Jacobians against
 //!    central finite differences.
 
 mod common;
 
-use common::{casadi_fixture, central, matrix, min_eigenvalue, relative_error, vector};
-use moreau::{Model, Sensitivities};
+use common::casadi::{against_casadi, defaults_match, points};
+use common::{central, min_eigenvalue, relative_error};
+use moreau::Model;
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector};
-
-/// Agreement with CasADi required of every output.
-const CASADI_TOLERANCE: f64 = 1e-12;
-
-/// One sample point of a fixture, with the model's parameters set.
-struct Point<M, const N: usize, const NU: usize> {
-    model: M,
-    t: f64,
-    q: SVector<f64, N>,
-    v: SVector<f64, N>,
-    u: SVector<f64, NU>,
-    json: serde_json::Value,
-}
-
-fn points<M, const N: usize, const K: usize, const NU: usize>(stem: &str) -> Vec<Point<M, N, NU>>
-where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
-{
-    let fixture = casadi_fixture(stem);
-    assert_eq!(fixture["model"], M::INFO.name);
-    let names: Vec<&str> = fixture["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| p.as_str().unwrap())
-        .collect();
-    assert_eq!(names, M::INFO.parameters, "parameter order");
-    let points = fixture["points"].as_array().unwrap();
-    assert!(points.len() >= 20, "{stem}: only {} points", points.len());
-    points
-        .iter()
-        .map(|p| {
-            let mut model = M::default();
-            for (i, value) in p["p"].as_array().unwrap().iter().enumerate() {
-                *model.parameter_mut(i).unwrap() = value.as_f64().unwrap();
-            }
-            Point {
-                model,
-                t: p["t"].as_f64().unwrap(),
-                q: vector(&p["q"]),
-                v: vector(&p["v"]),
-                u: vector(&p["u"]),
-                json: p.clone(),
-            }
-        })
-        .collect()
-}
-
-fn check_close<const R: usize, const C: usize>(
-    what: &str,
-    ours: &SMatrix<f64, R, C>,
-    casadi: &SMatrix<f64, R, C>,
-) {
-    let err = relative_error(ours, casadi);
-    assert!(
-        err <= CASADI_TOLERANCE,
-        "{what}: relative error {err:e}\nours   = {ours}\nCasADi = {casadi}"
-    );
-}
-
-/// Every generated method of `M` against the CasADi fixture `stem`.
-fn against_casadi<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
-where
-    M: Sensitivities<N, K> + Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
-{
-    for (i, p) in points::<M, N, K, NU>(stem).iter().enumerate() {
-        let at = |what: &str| format!("{stem} point {i}: {what}");
-        let (m, t, q, v, u) = (&p.model, p.t, &p.q, &p.v, &p.u);
-        let mass: SMatrix<f64, N, N> = matrix(&p.json["M"]);
-        let coriolis: SMatrix<f64, N, N> = matrix(&p.json["C"]);
-        let gravity: SVector<f64, N> = vector(&p.json["G"]);
-        let forces: SVector<f64, N> = vector(&p.json["F"]);
-        let gaps: SVector<f64, K> = vector(&p.json["h"]);
-        let jacobian: SMatrix<f64, K, N> = matrix(&p.json["J"]);
-        let dfdq: SMatrix<f64, N, N> = matrix(&p.json["dFdq"]);
-        let dfdv: SMatrix<f64, N, N> = matrix(&p.json["dFdv"]);
-
-        // the per-quantity methods
-        check_close(&at("M"), &m.mass(q), &mass);
-        check_close(&at("C"), &m.coriolis(q, v), &coriolis);
-        check_close(&at("G"), &m.gravity(q), &gravity);
-        check_close(&at("F"), &m.forces(t, q, v, u), &forces);
-        check_close(&at("h"), &m.gaps(q), &gaps);
-        check_close(&at("J"), &m.gap_jacobian(q), &jacobian);
-        // the fused evaluation and its cuts
-        let all = m.eval(t, q, v, u);
-        check_close(&at("eval M"), &all.mass, &mass);
-        check_close(&at("eval C"), &all.coriolis, &coriolis);
-        check_close(&at("eval G"), &all.gravity, &gravity);
-        check_close(&at("eval F"), &all.forces, &forces);
-        check_close(&at("eval h"), &all.gaps, &gaps);
-        check_close(&at("eval J"), &all.jacobian, &jacobian);
-        let (dm, df) = m.dynamics(t, q, v, u);
-        check_close(&at("dynamics M"), &dm, &mass);
-        check_close(&at("dynamics F"), &df, &forces);
-        let (ch, cj) = m.contact(q);
-        check_close(&at("contact h"), &ch, &gaps);
-        check_close(&at("contact J"), &cj, &jacobian);
-        let lin = m.linearization(t, q, v, u);
-        check_close(&at("linearization M"), &lin.mass, &mass);
-        check_close(&at("linearization F"), &lin.forces, &forces);
-        check_close(&at("∂F/∂q"), &lin.forces_dq, &dfdq);
-        check_close(&at("∂F/∂v"), &lin.forces_dv, &dfdv);
-        // the sensitivities (∂(M v)/∂q, ∂(J v)/∂q at the point's v)
-        let dmvdq: SMatrix<f64, N, N> = matrix(&p.json["dMvdq"]);
-        let djvdq: SMatrix<f64, K, N> = matrix(&p.json["dJvdq"]);
-        check_close(&at("∂(M v)/∂q"), &m.mass_dq(q, v), &dmvdq);
-        check_close(&at("∂(J v)/∂q"), &m.jacobian_dq(q, v), &djvdq);
-    }
-}
 
 #[test]
 fn parabola_matches_casadi() {
@@ -155,29 +49,11 @@ fn arm3_matches_casadi() {
 /// The restitution coefficients and the parameter defaults are the file's.
 #[test]
 fn defaults_match_the_model_files() {
-    fn defaults<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
-    where
-        M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
-    {
-        let fixture = casadi_fixture(stem);
-        let model = M::default();
-        let expected: SVector<f64, K> = vector(&fixture["restitution"]);
-        assert_eq!(model.restitution(), expected, "{stem}");
-        for (i, d) in fixture["parameter_defaults"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .enumerate()
-        {
-            assert_eq!(model.parameter(i), d.as_f64(), "{stem} parameter {i}");
-        }
-        assert_eq!(model.parameter(M::INFO.parameters.len()), None);
-    }
-    defaults::<Parabola, 2, 2, 0>("parabola");
-    defaults::<ThreeBalls, 3, 4, 0>("three_balls");
-    defaults::<Billiard, 2, 4, 0>("billiard");
-    defaults::<DoublePendulum, 2, 2, 0>("double_pendulum");
-    defaults::<Arm3, 3, 1, 3>("arm3");
+    defaults_match::<Parabola, 2, 2, 0>("parabola");
+    defaults_match::<ThreeBalls, 3, 4, 0>("three_balls");
+    defaults_match::<Billiard, 2, 4, 0>("billiard");
+    defaults_match::<DoublePendulum, 2, 2, 0>("double_pendulum");
+    defaults_match::<Arm3, 3, 1, 3>("arm3");
 }
 
 /// What needs no CasADi, at the fixture's points: M symmetric positive

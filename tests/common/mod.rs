@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod casadi;
 pub mod runs;
 
 use std::path::PathBuf;
@@ -52,7 +53,17 @@ pub fn relative_error<const R: usize, const C: usize>(
     a: &SMatrix<f64, R, C>,
     b: &SMatrix<f64, R, C>,
 ) -> f64 {
-    let scale = b.amax();
+    relative_error_above(a, b, 0.0)
+}
+
+/// [`relative_error`] with the scale at least `floor`: the size of the
+/// terms whose sum `b` is, when `b` is a small difference of them.
+pub fn relative_error_above<const R: usize, const C: usize>(
+    a: &SMatrix<f64, R, C>,
+    b: &SMatrix<f64, R, C>,
+    floor: f64,
+) -> f64 {
+    let scale = b.amax().max(floor);
     a.iter()
         .zip(b.iter())
         .map(|(x, y)| {

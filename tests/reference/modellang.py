@@ -15,6 +15,14 @@ that YAML 1.1 quirks (``no``/``on``/``off`` read as booleans, ``1e-3`` read
 as a string) cannot differ from a YAML 1.2 reader: expressions keep their
 exact text and numbers are parsed here. Duplicate mapping keys are errors.
 
+A kinematic tree (`bodies`, or a URDF named by `urdf` with `locked` and
+`limits`, and `gravity`) is read by ``tests/reference/tree.py`` (the URDF
+with :mod:`xml.etree`), and :func:`build_casadi` adds its kinetic and
+potential energies, built from the bodies' poses, to those written; in
+expressions, `position_x(body, x, y, z)` (`_y`, `_z`; `position_x(body)`
+for the frame's origin) and `direction_x(body, x, y, z)` are the world
+coordinates of a point and a direction of a body.
+
 Only the standard library and PyYAML are needed to load a model;
 :func:`build_casadi` imports CasADi when called. The language's rules are
 checked by the Rust front end only (see ``_validate``).
@@ -24,6 +32,9 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
+
+from .tree import JOINT_TYPES, Body, UrdfError, build_tree, read_urdf
 
 __all__ = [
     "ModelError",
@@ -50,8 +61,15 @@ FUNCTIONS = {
     "cosh": 1,
     "tanh": 1,
 }
+# The calls of a body's frame: a point (`position_x(body)` or
+# `position_x(body, x, y, z)`) or a direction (`direction_x(body, x, y, z)`).
+FRAME_FUNCTIONS = {
+    f"{kind}_{axis}": (kind, i)
+    for kind in ("position", "direction")
+    for i, axis in enumerate("xyz")
+}
 BUILTIN_NAMES = ("t", "pi")
-RESERVED = set(FUNCTIONS) | set(BUILTIN_NAMES)
+RESERVED = set(FUNCTIONS) | set(FRAME_FUNCTIONS) | set(BUILTIN_NAMES)
 
 IDENT_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 # A number in an expression: 2, 0.5, 1e-3, 2.5E+4, 1. (no sign, no leading dot).
@@ -73,6 +91,7 @@ class ModelError(ValueError):
 #   ("neg", a)                unary minus
 #   ("add"|"sub"|"mul"|"div"|"pow", a, b)
 #   ("call", fname, (args...))
+#   ("frame", "position"|"direction", axis 0..2, body, (x, y, z))
 # --------------------------------------------------------------------------
 
 
@@ -188,6 +207,8 @@ class _Parser:
             if self.is_op("("):
                 self.next()
                 fname = tok.text
+                if fname in FRAME_FUNCTIONS:
+                    return self.frame(fname, tok)
                 if fname not in FUNCTIONS:
                     raise ModelError(f"unknown function {fname!r} at column {tok.pos + 1}")
                 args = [self.expr()]
@@ -212,6 +233,28 @@ class _Parser:
             return node
         raise self.error(tok, "expected a number, a name or '('")
 
+    def frame(self, fname: str, tok: _Tok):
+        kind, axis = FRAME_FUNCTIONS[fname]
+        args = [self.expr()]
+        while self.is_op(","):
+            self.next()
+            args.append(self.expr())
+        self.expect(")")
+        if args[0][0] != "name":
+            raise ModelError(
+                f"the first argument of {fname} is a body, at column {tok.pos + 1}"
+            )
+        if len(args) == 4:
+            point = tuple(args[1:])
+        elif len(args) == 1 and kind == "position":
+            point = (("num", 0.0),) * 3
+        else:
+            raise ModelError(
+                f"{fname} takes a body and three coordinates, got {len(args)} "
+                f"argument(s) at column {tok.pos + 1}"
+            )
+        return ("frame", kind, axis, args[0][1], point)
+
 
 def parse_expr(text: str):
     """Parse one expression of the model language into an AST (tuples)."""
@@ -233,6 +276,8 @@ def free_names(node) -> set[str]:
             stack.append(nd[1])
         elif kind == "call":
             stack.extend(nd[2])
+        elif kind == "frame":
+            stack.extend(nd[4])  # the body is not a number
         else:
             stack.append(nd[1])
             stack.append(nd[2])
@@ -298,6 +343,10 @@ class Model:
     constraints: list[Constraint]
     initial: dict[str, float]
     ast: dict = field(default_factory=dict)
+    # A kinematic tree (`bodies`, `urdf`): its bodies (tests/reference/tree.py)
+    # and the gravity vector's ASTs (None: the default [0, 0, -9.81]).
+    bodies: list = field(default_factory=list)
+    gravity: list | None = None
 
     @property
     def n(self) -> int:
@@ -321,6 +370,11 @@ _KEYS = {
     "constraints",
     "restitution",
     "initial",
+    "urdf",
+    "locked",
+    "limits",
+    "bodies",
+    "gravity",
 }
 
 
@@ -342,15 +396,26 @@ def _expr_text(value, where: str) -> str:
     return value
 
 
+def _crate_dir(path: Path) -> Path:
+    """The nearest directory above ``path`` with a ``Cargo.toml``: what a
+    model's ``urdf`` path is relative to."""
+    for d in path.resolve().parents:
+        if (d / "Cargo.toml").is_file():
+            return d
+    return Path.cwd()
+
+
 def load_model(path) -> Model:
-    """Read and validate a model file."""
+    """Read and validate a model file (a `urdf` it names is found relative
+    to the nearest directory above it with a ``Cargo.toml``, the crate's)."""
     with open(path, encoding="utf-8") as fh:
         text = fh.read()
-    return load_model_text(text, str(path))
+    return load_model_text(text, str(path), _crate_dir(Path(path)))
 
 
-def load_model_text(text: str, origin: str = "<model>") -> Model:
-    """Parse and validate the YAML text of a model."""
+def load_model_text(text: str, origin: str = "<model>", crate_dir=None) -> Model:
+    """Parse and validate the YAML text of a model; ``crate_dir`` (default:
+    the working directory) is where a `urdf` path starts."""
     import yaml
 
     try:
@@ -358,12 +423,12 @@ def load_model_text(text: str, origin: str = "<model>") -> Model:
     except yaml.YAMLError as exc:
         raise ModelError(f"{origin}: invalid YAML: {exc}") from None
     try:
-        return _validate(doc)
-    except ModelError as exc:
+        return _validate(doc, Path(crate_dir) if crate_dir is not None else Path.cwd())
+    except (ModelError, UrdfError) as exc:
         raise ModelError(f"{origin}: {exc}") from None
 
 
-def _validate(doc) -> Model:
+def _validate(doc, crate_dir: Path) -> Model:
     """Reads the model's structure. The rules of the language (unique and
     reserved names, declared names, restitution in [0, 1], what T, V and h
     may depend on, ...) are the Rust front end's alone (model-macro's
@@ -376,7 +441,8 @@ def _validate(doc) -> Model:
     unknown = sorted(set(doc) - _KEYS)
     if unknown:
         raise ModelError(f"unknown key(s): {', '.join(unknown)}")
-    for key in ("name", "coordinates", "kinetic"):
+    has_tree = "bodies" in doc or "urdf" in doc
+    for key in ("name",) if has_tree else ("name", "coordinates", "kinetic"):
         if key not in doc:
             raise ModelError(f"missing required key {key!r}")
 
@@ -390,8 +456,10 @@ def _validate(doc) -> Model:
     def declare(nm: str, what: str) -> None:
         kinds[nm] = what
 
-    coords_raw = doc["coordinates"]
-    if not isinstance(coords_raw, list) or not coords_raw:
+    coords_raw = doc.get("coordinates", [])
+    if coords_raw in ("", None) and has_tree:
+        coords_raw = []
+    if not isinstance(coords_raw, list) or not (coords_raw or has_tree):
         raise ModelError("coordinates: expected a non-empty list of `position: velocity`")
     coordinates, velocities = [], []
     for i, entry in enumerate(coords_raw):
@@ -447,7 +515,28 @@ def _validate(doc) -> Model:
         ast[role_key] = node
         return text
 
-    kinetic = expr(("kinetic",), _expr_text(doc["kinetic"], "kinetic"), "kinetic")
+    # The tree's joints: coordinates after the written ones, the bodies'
+    # (in the order written) before the URDF's.
+    bodies = _bodies(doc.get("bodies", []), coordinates, velocities)
+    limits: dict[str, tuple[float, float]] = {}
+    if "urdf" in doc:
+        urdf = read_urdf(
+            crate_dir / _expr_text(doc["urdf"], "urdf"),
+            _names(doc.get("locked", []), "locked"),
+            len(coordinates),
+        )
+        bodies.extend(urdf.bodies)
+        for qn, vn in urdf.coordinates:
+            coordinates.append(qn)
+            velocities.append(vn)
+        limits = urdf.limits
+    elif "locked" in doc or "limits" in doc:
+        raise ModelError("`locked` and `limits` name joints of a URDF, but there is no `urdf`")
+    gravity = None
+    if "gravity" in doc:
+        gravity = _triple(doc["gravity"], "gravity")
+
+    kinetic = expr(("kinetic",), _expr_text(doc.get("kinetic", "0"), "kinetic"), "kinetic")
     potential = expr(
         ("potential",), _expr_text(doc.get("potential", "0"), "potential"), "potential"
     )
@@ -491,6 +580,16 @@ def _validate(doc) -> Model:
                 f"constraints.{cn}: no restitution (give it one, or a top-level `restitution`)"
             )
         constraints.append(Constraint(cn, h, e))
+    for joint in _names(doc.get("limits", []), "limits"):
+        if joint not in limits:
+            raise ModelError(f"limits: `{joint}` is not a moving joint with a <limit lower upper>")
+        if default_e is None:
+            raise ModelError("limits: the limits' constraints take the top-level `restitution`")
+        lower, upper = limits[joint]
+        bounds = (("lower", f"{joint} - ({lower!r})"), ("upper", f"({upper!r}) - {joint}"))
+        for suffix, text in bounds:
+            cn = f"{joint}_{suffix}"
+            constraints.append(Constraint(cn, expr(("constraint", cn), text, cn), default_e))
 
     init_raw = doc.get("initial", {})
     if init_raw in ("", None):
@@ -515,9 +614,86 @@ def _validate(doc) -> Model:
         constraints=constraints,
         initial=initial,
         ast=ast,
+        bodies=bodies,
+        gravity=gravity,
     )
 
     return model
+
+
+def _names(value, where: str) -> list[str]:
+    if value in ("", None):
+        return []
+    if not isinstance(value, list):
+        raise ModelError(f"{where}: expected a list of names")
+    return [_ident(x, where) for x in value]
+
+
+def _triple(value, where: str) -> list:
+    if not isinstance(value, list) or len(value) != 3:
+        raise ModelError(f"{where}: expected three expressions [x, y, z]")
+    return [_parse_in(_expr_text(x, where), where) for x in value]
+
+
+_BODY_KEYS = {"name", "parent", "joint", "mass", "com", "inertia"}
+_JOINT_KEYS = {"type", "name", "velocity", "axis", "xyz", "rpy"}
+
+
+def _bodies(raw, coordinates: list[str], velocities: list[str]) -> list:
+    """`bodies:` as :class:`tree.Body`; each moving joint appends its
+    coordinate (and velocity, `d<name>` by default)."""
+    if raw in ("", None):
+        return []
+    if not isinstance(raw, list):
+        raise ModelError("bodies: expected a list of bodies")
+    out = []
+    zero = ("num", 0.0)
+    for i, b in enumerate(raw):
+        where = f"bodies[{i}]"
+        required = {"name", "joint", "mass"}
+        if not isinstance(b, dict) or set(b) - _BODY_KEYS or not required <= set(b):
+            raise ModelError(
+                f"{where}: a body has name, joint, mass and optionally parent, com, inertia"
+            )
+        j = b["joint"]
+        if not isinstance(j, dict) or set(j) - _JOINT_KEYS or j.get("type") not in JOINT_TYPES:
+            raise ModelError(f"{where}.joint: a joint has a type ({', '.join(JOINT_TYPES)}) "
+                             f"and name, velocity, axis, xyz, rpy")
+        kind = j["type"]
+        coordinate = None
+        axis = (0.0, 0.0, 1.0)
+        if kind != "fixed":
+            qn = _ident(j.get("name"), f"{where}.joint.name")
+            vn = _ident(j.get("velocity", "d" + qn), f"{where}.joint.velocity")
+            coordinate = len(coordinates)
+            coordinates.append(qn)
+            velocities.append(vn)
+            ax = j.get("axis")
+            if not isinstance(ax, list) or len(ax) != 3:
+                raise ModelError(f"{where}.joint.axis: expected three numbers")
+            axis = tuple(_number(x, f"{where}.joint.axis") for x in ax)
+            if not any(axis):
+                raise ModelError(f"{where}.joint.axis: zero axis")
+        parent = b.get("parent", "world")
+        inertia = b.get("inertia")
+        if inertia is not None and (not isinstance(inertia, list) or len(inertia) != 6):
+            raise ModelError(f"{where}.inertia: expected six expressions")
+        out.append(
+            Body(
+                name=_ident(b["name"], f"{where}.name"),
+                parent=None if parent == "world" else _ident(parent, f"{where}.parent"),
+                kind=kind,
+                coordinate=coordinate,
+                axis=axis,
+                xyz=_triple(j["xyz"], f"{where}.joint.xyz") if "xyz" in j else [zero] * 3,
+                rpy=_triple(j["rpy"], f"{where}.joint.rpy") if "rpy" in j else [zero] * 3,
+                mass=_parse_in(_expr_text(b["mass"], f"{where}.mass"), f"{where}.mass"),
+                com=_triple(b["com"], f"{where}.com") if "com" in b else [zero] * 3,
+                inertia=[_parse_in(_expr_text(x, f"{where}.inertia"), f"{where}.inertia")
+                         for x in inertia] if inertia is not None else [zero] * 6,
+            )
+        )
+    return out
 
 
 def _parse_in(text: str, where: str):
@@ -540,6 +716,12 @@ def _to_sx(node, env, ca):
         return env[node[1]]
     if kind == "neg":
         return -_to_sx(node[1], env, ca)
+    if kind == "frame":
+        _, fkind, axis, body, point = node
+        r, p = env["@frames"][body]
+        local = ca.vertcat(*[_to_sx(x, env, ca) for x in point])
+        world = ca.mtimes(r, local)
+        return (world + p if fkind == "position" else world)[axis]
     if kind == "call":
         args = [_to_sx(a, env, ca) for a in node[2]]
         fname = node[1]
@@ -589,7 +771,8 @@ class CasadiModel:
 
 
 def build_casadi(model: Model) -> CasadiModel:
-    """Build T, V, Q and h as CasADi SX expressions."""
+    """Build T, V, Q and h as CasADi SX expressions (a tree's energies
+    included: :func:`tree.build_tree`)."""
     import casadi as ca
 
     t = ca.SX.sym("t")
@@ -606,11 +789,27 @@ def build_casadi(model: Model) -> CasadiModel:
         env[nm] = u[i]
     for i, nm in enumerate(model.parameters):
         env[nm] = p[i]
+    T_tree = V_tree = ca.SX(0)
+    if model.bodies:
+        grav = model.gravity or [("num", 0.0), ("num", 0.0), ("num", -9.81)]
+        try:
+            tree = build_tree(
+                model.bodies,
+                ca.vertcat(*[_to_sx(x, env, ca) for x in grav]),
+                q,
+                v,
+                lambda node: _to_sx(node, env, ca),
+                ca,
+            )
+        except UrdfError as exc:
+            raise ModelError(f"{model.name}: {exc}") from None
+        env["@frames"] = tree.frames
+        T_tree, V_tree = tree.T, tree.V
     for nm in model.definitions:
         env[nm] = _to_sx(model.ast[("definition", nm)], env, ca)
 
-    T = _to_sx(model.ast[("kinetic",)], env, ca)
-    V = _to_sx(model.ast[("potential",)], env, ca)
+    T = _to_sx(model.ast[("kinetic",)], env, ca) + T_tree
+    V = _to_sx(model.ast[("potential",)], env, ca) + V_tree
     Q = ca.SX.zeros(model.n, 1)
     for i, nm in enumerate(model.coordinates):
         if nm in model.applied:
