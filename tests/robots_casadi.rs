@@ -28,6 +28,7 @@ moreau::model!(file = "tests/robots/ur5.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
 moreau::model!(file = "tests/robots/serial_12.yaml");
 moreau::model!(file = "tests/robots/slider_arm_mixed.yaml");
+moreau::model!(file = "tests/robots/go1.yaml");
 
 #[test]
 fn two_link_tree_matches_casadi() {
@@ -75,4 +76,10 @@ fn serial_12_matches_casadi() {
 fn slider_arm_mixed_matches_casadi() {
     against_casadi::<SliderArmMixed, 5, 6, 1>("robots/slider_arm_mixed");
     defaults_match::<SliderArmMixed, 5, 6, 1>("robots/slider_arm_mixed");
+}
+
+#[test]
+fn go1_matches_casadi() {
+    against_casadi::<Go1, 12, 6, 0>("robots/go1");
+    defaults_match::<Go1, 12, 6, 0>("robots/go1");
 }
