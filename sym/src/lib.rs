@@ -55,6 +55,7 @@ pub mod eval;
 pub mod graph;
 pub mod mechanics;
 pub mod node;
+pub mod reverse;
 pub mod schedule;
 #[cfg(test)]
 mod testing;
