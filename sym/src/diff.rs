@@ -115,38 +115,47 @@ impl Graph {
             Node::Const(_) => self.constant(0.0),
             // f = x
             Node::Var(v) => self.constant(if v == wrt { 1.0 } else { 0.0 }),
+            node => {
+                let zero = self.constant(0.0);
+                let mut d = [zero; 2];
+                for (d, &c) in d.iter_mut().zip(node.children()) {
+                    *d = self.d(c, wrt);
+                }
+                self.tangent(f, d)
+            }
+        }
+    }
+
+    /// The differential `df` of the operation `f` given the differentials
+    /// of its operands (`[da]` or `[da, db]`, the second ignored for a
+    /// unary operation). Linear in `(da, db)`, so it is also the local
+    /// partial of reverse mode: `tangent(f, [ā, 0])` is `ā ∂f/∂a`.
+    ///
+    /// # Panics
+    /// If `f` is a constant or a variable (no operands).
+    pub(crate) fn tangent(&mut self, f: Id, [da, db]: [Id; 2]) -> Id {
+        match self.node(f) {
+            Node::Const(_) | Node::Var(_) => unreachable!("a leaf has no operands"),
             // f = a + b: df = da + db
-            Node::Add([a, b]) => {
-                let (da, db) = (self.d(a, wrt), self.d(b, wrt));
-                self.add(da, db)
-            }
+            Node::Add(_) => self.add(da, db),
             // f = a - b: df = da - db
-            Node::Sub([a, b]) => {
-                let (da, db) = (self.d(a, wrt), self.d(b, wrt));
-                self.sub(da, db)
-            }
+            Node::Sub(_) => self.sub(da, db),
             // f = a b: df = da b + a db
             Node::Mul([a, b]) => {
-                let (da, db) = (self.d(a, wrt), self.d(b, wrt));
                 let t = self.mul(da, b);
                 let u = self.mul(a, db);
                 self.add(t, u)
             }
             // f = a / b: df = (da - f db) / b
-            Node::Div([a, b]) => {
-                let (da, db) = (self.d(a, wrt), self.d(b, wrt));
+            Node::Div([_, b]) => {
                 let t = self.mul(f, db);
                 let n = self.sub(da, t);
                 self.div(n, b)
             }
             // f = -a: df = -da
-            Node::Neg(a) => {
-                let da = self.d(a, wrt);
-                self.neg(da)
-            }
+            Node::Neg(_) => self.neg(da),
             // f = a^n: df = n a^(n-1) da
             Node::Powi(a, n) => {
-                let da = self.d(a, wrt);
                 let p = match n.checked_sub(1) {
                     Some(m) => self.powi(a, m),
                     None => {
@@ -158,33 +167,11 @@ impl Graph {
                 let t = self.mul(c, p);
                 self.mul(t, da)
             }
-            // f = a^b: df = b a^(b-1) da + f ln(a) db (second term dropped
-            // when b is constant, first when a is)
-            Node::Pow([a, b]) => {
-                let (da, db) = (self.d(a, wrt), self.d(b, wrt));
-                let mut df = self.constant(0.0);
-                if !self.is_zero(da) {
-                    let one = self.constant(1.0);
-                    let bm1 = self.sub(b, one);
-                    let p = self.pow(a, bm1);
-                    let t = self.mul(b, p);
-                    df = self.mul(t, da);
-                }
-                if !self.is_zero(db) {
-                    let l = self.ln(a);
-                    let t = self.mul(f, l);
-                    let t = self.mul(t, db);
-                    df = self.add(df, t);
-                }
-                df
-            }
-            Node::Func(func, a) => {
-                let da = self.d(a, wrt);
-                self.diff_func(func, f, a, da)
-            }
+            Node::Pow([a, b]) => self.pow_tangent(f, [a, b], [da, db]),
+            Node::Func(func, a) => self.diff_func(func, f, a, da),
             // f = atan2(y, x): df = (x dy - y dx) / (x^2 + y^2)
             Node::Atan2([y, x]) => {
-                let (dy, dx) = (self.d(y, wrt), self.d(x, wrt));
+                let (dy, dx) = (da, db);
                 let t = self.mul(x, dy);
                 let u = self.mul(y, dx);
                 let n = self.sub(t, u);
@@ -194,6 +181,26 @@ impl Graph {
                 self.div(n, r2)
             }
         }
+    }
+
+    /// `f = a^b`: `df = b a^(b-1) da + f ln(a) db` (second term dropped
+    /// when `db` is zero, first when `da` is).
+    fn pow_tangent(&mut self, f: Id, [a, b]: [Id; 2], [da, db]: [Id; 2]) -> Id {
+        let mut df = self.constant(0.0);
+        if !self.is_zero(da) {
+            let one = self.constant(1.0);
+            let bm1 = self.sub(b, one);
+            let p = self.pow(a, bm1);
+            let t = self.mul(b, p);
+            df = self.mul(t, da);
+        }
+        if !self.is_zero(db) {
+            let l = self.ln(a);
+            let t = self.mul(f, l);
+            let t = self.mul(t, db);
+            df = self.add(df, t);
+        }
+        df
     }
 
     /// The derivative of `f = func(a)` given `da`.

@@ -10,6 +10,7 @@
 //! | [`node`] | [`Node`], [`Id`], [`VarId`], [`Func`], [`Op`]: the vocabulary |
 //! | [`graph`] | [`Graph`]: hash-consed arena, simplifying builders, queries |
 //! | [`diff`] | [`Graph::diff`]: exact derivatives, one rule per node |
+//! | [`reverse`] | [`Graph::gradient_reverse`]: a gradient by one adjoint sweep |
 //! | [`eval`] | [`Graph::eval`]: the reference interpreter |
 //! | [`mechanics`] | [`Mechanics::derive`]: `M`, `C`, `G`, `F`, `J` and their derivatives from `T`, `V`, `Q`, `h`; [`Layout`], the one list of outputs |
 //! | [`schedule`] | [`Schedule`]: one CSE'd instruction list for all outputs |
@@ -55,6 +56,7 @@ pub mod eval;
 pub mod graph;
 pub mod mechanics;
 pub mod node;
+pub mod reverse;
 pub mod schedule;
 #[cfg(test)]
 mod testing;

@@ -185,7 +185,9 @@ fn sin_cos(g: &mut Graph, x: Id) -> (Id, Id) {
 }
 
 /// The rotation by `angle` about the unit `axis`:
-/// `cos θ I + sin θ [a]× + (1 − cos θ) a aᵀ`.
+/// `cos θ I + sin θ [a]× + (1 − cos θ) a aᵀ`. About a coordinate axis the
+/// builders fold it to the exact rotation: the zero entries of `a` drop
+/// their terms and `cos θ + (1 − cos θ)` is `1` (`a + (b − a) → b`).
 fn rodrigues(g: &mut Graph, a: [f64; 3], angle: Id) -> M3 {
     let (s, c) = (g.sin(angle), g.cos(angle));
     let one = g.constant(1.0);

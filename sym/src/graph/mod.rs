@@ -14,13 +14,14 @@
 //! caveat is `0 / x → 0`, which is wrong for `x = 0` (where `0 / 0` is NaN);
 //! a model dividing zero by zero is broken anyway. Rules whose value differs
 //! on non-finite inputs (`x * 0 → 0` for `x = ∞`, `x - x → 0` for `x = NaN`)
-//! are accepted on the same ground as in CasADi.
+//! are accepted on the same ground as in CasADi, and so are the
+//! cancellations `a + (b - a) → b` and their kin (`∞ + (b - ∞)` is NaN).
 //!
 //! | builder | rules |
 //! |---|---|
 //! | all | constant folding with Rust's `f64` operations |
-//! | [`add`](Graph::add) | `x + 0 → x`, `0 + x → x`, `a + (-b) → a - b`, `(-a) + b → b - a`, `x + x → 2 * x`, `c1 * x + c2 * x → (c1 + c2) * x`, `c * x + c * y → c * (x + y)`, canonical operand order (below) |
-//! | [`sub`](Graph::sub) | `x - 0 → x`, `0 - x → -x`, `x - x → 0`, `a - (-b) → a + b`, `(-a) - b → -(a + b)`, `c1 * x - c2 * x → (c1 - c2) * x`, `c * x - c * y → c * (x - y)` |
+//! | [`add`](Graph::add) | `x + 0 → x`, `0 + x → x`, `a + (b - a) → b`, `(b - a) + a → b`, `a + (-b) → a - b`, `(-a) + b → b - a`, `x + x → 2 * x`, `c1 * x + c2 * x → (c1 + c2) * x`, `c * x + c * y → c * (x + y)`, canonical operand order (below) |
+//! | [`sub`](Graph::sub) | `x - 0 → x`, `0 - x → -x`, `x - x → 0`, `(x + y) - x → y`, `(x + y) - y → x`, `a - (a - y) → y`, `a - (-b) → a + b`, `(-a) - b → -(a + b)`, `c1 * x - c2 * x → (c1 - c2) * x`, `c * x - c * y → c * (x - y)` |
 //! | [`mul`](Graph::mul) | `x * 0 → 0`, `x * 1 → x`, `x * (-1) → -x`, canonical operand order (below), `c1 * (c2 * x) → (c1 c2) * x`, `c1 * (x / c2) → (c1 / c2) * x`, `c * (-x) → (-c) * x`, `(-a) * b → -(a * b)`, `(c * x) * y → c * (x * y)`, `x * x → x^2`, `x^m * x^n → x^(m+n)` for `m, n > 0` |
 //! | [`div`](Graph::div) | `x / 1 → x`, `x / (-1) → -x`, `0 / x → 0` (caveat above), `(-a) / b → -(a / b)`, `a / (-b) → -(a / b)`, `(c1 * x) / c2 → (c1 / c2) * x`, `(c * x) / y → c * (x / y)` |
 //! | [`neg`](Graph::neg) | `--x → x`, `-(a - b) → b - a`, `-(c * x) → (-c) * x` |

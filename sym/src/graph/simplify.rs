@@ -26,6 +26,13 @@ impl Graph {
         if self.is_zero(b) {
             return a;
         }
+        // a + (b - a) → b and (b - a) + a → b (`c + (1 - c)` of a rotation
+        // about a coordinate axis is `1`)
+        match (self.node(a), self.node(b)) {
+            (_, Node::Sub([y, x])) if x == a => return y,
+            (Node::Sub([y, x]), _) if x == b => return y,
+            _ => {}
+        }
         if let Node::Neg(y) = self.node(b) {
             return self.sub(a, y);
         }
@@ -76,6 +83,13 @@ impl Graph {
         }
         if a == b {
             return self.constant(0.0);
+        }
+        // (x + y) - x → y, (x + y) - y → x, a - (a - y) → y
+        match (self.node(a), self.node(b)) {
+            (Node::Add([x, y]), _) if x == b => return y,
+            (Node::Add([x, y]), _) if y == b => return x,
+            (_, Node::Sub([x, y])) if x == a => return y,
+            _ => {}
         }
         if let Node::Neg(y) = self.node(b) {
             return self.add(a, y);

@@ -156,6 +156,29 @@ fn sub_like_terms() {
 }
 
 #[test]
+fn add_and_sub_cancel_a_term() {
+    let (mut g, x, y, z) = xyz();
+    let d = g.sub(y, x); // y - x
+    assert_eq!(g.add(x, d), y);
+    assert_eq!(g.add(d, x), y);
+    let s = g.add(x, y);
+    assert_eq!(g.sub(s, x), y);
+    assert_eq!(g.sub(s, y), x);
+    assert_eq!(g.sub(y, d), x); // y - (y - x)
+    // a rotation about z: cos q + (1 - cos q) * 1 is 1
+    let one = g.constant(1.0);
+    let c = g.cos(z);
+    let k = g.sub(one, c);
+    let k1 = g.mul(k, one);
+    assert_eq!(g.add(c, k1), one);
+    // no cancellation without a shared term
+    let e = g.add(z, d);
+    assert_eq!(show(&g, e), "y - x + z");
+    let e = g.sub(s, z);
+    assert_eq!(show(&g, e), "x + y - z");
+}
+
+#[test]
 fn mul_zero_one_minus_one() {
     let (mut g, x, _, _) = xyz();
     let zero = g.constant(0.0);

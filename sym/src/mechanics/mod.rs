@@ -16,6 +16,20 @@
 //! With the Christoffel symbols `Γ`, `Ṁ − 2C` is skew-symmetric, which the
 //! observers' passivity argument needs.
 //!
+//! # Gap Jacobian
+//!
+//! A row of `J` is the gradient of one gap over all `N` coordinates: forward
+//! mode ([`Graph::gradient`]) sweeps the gap's expression once per
+//! coordinate, reverse mode ([`Graph::gradient_reverse`]) once in all. For
+//! the tip of a chain of `N` joints reverse mode is the smaller, by a factor
+//! growing with `N`; for a gap of few coordinates, or rows sharing their
+//! forward derivatives (three components of one point), forward mode can be.
+//! Neither count is known before building, so each row is built both ways
+//! and the one adding fewer operations to the fused evaluation (`M`, `C`,
+//! `G`, `F`, `h` and the rows before it, counted with sharing by
+//! [`Schedule`]) is kept, forward on a tie: `J` never costs more than
+//! forward mode alone. The two agree up to rounding.
+//!
 //! Each `M_ij` and `V` are put in the trigonometric normal form of
 //! [`TrigForm`] before they are differentiated, so that `sin² + cos²` of an
 //! angle cancels and products of `sin`/`cos` become waves of angle sums and
@@ -59,6 +73,7 @@ pub use recursive::Recursive;
 
 use crate::graph::{Graph, TrigForm};
 use crate::node::{Id, VarId};
+use crate::schedule::Schedule;
 use lincomb::{lincomb, sum};
 
 /// The inputs of [`Mechanics::derive`]: a Lagrangian system with unilateral
@@ -293,7 +308,15 @@ impl Mechanics {
             Some(t) if !written_t => t.forces(g, sys, &written_g),
             _ => total_forces(g, sys, &coriolis, &gravity),
         };
-        let jacobian = g.jacobian(sys.gaps, sys.q);
+        let eval: Vec<Id> = [&mass, &coriolis]
+            .into_iter()
+            .flatten()
+            .flatten()
+            .chain([&gravity, &forces].into_iter().flatten())
+            .chain(sys.gaps)
+            .copied()
+            .collect();
+        let jacobian = gap_jacobian(g, sys, eval);
         let force_dq = g.jacobian(&forces, sys.q);
         let force_dv = match tree {
             Some(t) if !written_t => t.forces_dv(g, sys, &coriolis),
@@ -416,6 +439,29 @@ fn mass_matrix(
         mass[j][i] = m;
     }
     Ok((momentum, mass))
+}
+
+/// `J = ∂h/∂q`, each row by forward or by reverse mode, whichever adds
+/// fewer operations to `eval` (the rest of the fused evaluation) and the
+/// rows already chosen; forward on a tie (see the [module docs](self)).
+fn gap_jacobian(g: &mut Graph, sys: &Lagrangian<'_>, mut eval: Vec<Id>) -> Vec<Vec<Id>> {
+    let mut jacobian = Vec::with_capacity(sys.gaps.len());
+    for &h in sys.gaps {
+        let forward = g.gradient(h, sys.q);
+        let reverse = g.gradient_reverse(h, sys.q);
+        let cost = |row: &[Id]| {
+            let outputs: Vec<Id> = eval.iter().chain(row).copied().collect();
+            Schedule::new(g, &outputs).op_count()
+        };
+        let row = if cost(&reverse) < cost(&forward) {
+            reverse
+        } else {
+            forward
+        };
+        eval.extend_from_slice(&row);
+        jacobian.push(row);
+    }
+    jacobian
 }
 
 /// `dm[i][j][k] = ∂M_ij/∂q_k`, built for `i ≤ j` and mirrored.

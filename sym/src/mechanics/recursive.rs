@@ -21,7 +21,9 @@
 //!
 //! The graph's derivatives are forward-mode and memoized per node, so each
 //! derivative of a recursion costs at most a constant times the nodes that
-//! depend on the variable: differentiating stays polynomial.
+//! depend on the variable: differentiating stays polynomial. A row of `J`
+//! is built in reverse mode instead when that adds fewer operations (see
+//! the [`Gap Jacobian`](super#gap-jacobian) section).
 
 use crate::graph::Graph;
 use crate::node::Id;
