@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use moreau_sym::{Func, Layout, Op, Operand, Schedule, Slot, VarId};
+use moreau_sym::{Func, Layout, Op, Operand, Schedule, VarId};
 
 use super::names::{Local, Names, Role};
 use crate::resolve::{Resolved, VarLayout};
@@ -162,10 +162,16 @@ pub(crate) fn build(
             output_of[t as usize].get_or_insert(outputs.slot(index));
         }
     }
-    let partner = sin_cos_partners(&sched, &output_of);
+    let partner = sin_cos_partners(&sched);
     let mut pending: HashMap<usize, Code> = HashMap::new();
     for (k, instr) in sched.instrs.iter().enumerate() {
+        // an output read from a `sin_cos` pair is bound to its slot's name
+        let as_output = |b: &mut Builder, code: Code| match output_of[k] {
+            Some(slot) => b.bind(Local::Output(slot), code, Some(slot.describe())),
+            None => code,
+        };
         if let Some(code) = pending.remove(&k) {
+            let code = as_output(&mut b, code);
             b.codes.push(Some(code));
             continue;
         }
@@ -177,6 +183,7 @@ pub(crate) fn build(
                 _ => (cos, sin),
             };
             pending.insert(p, theirs);
+            let mine = as_output(&mut b, mine);
             b.codes.push(Some(mine));
             continue;
         }
@@ -238,9 +245,9 @@ fn read_vars(b: &Builder<'_, '_>, outputs: &[Code]) -> Vec<Var> {
 }
 
 /// For the first of two instructions `sin a` and `cos a` of one operand,
-/// neither of them an output, the index of the other (computed together by
-/// one `sin_cos`).
-fn sin_cos_partners(sched: &Schedule, output_of: &[Option<Slot>]) -> Vec<Option<usize>> {
+/// the index of the other (computed together by one `sin_cos`; an output
+/// among them is then bound to the pair's name).
+fn sin_cos_partners(sched: &Schedule) -> Vec<Option<usize>> {
     let key = |a: Operand| match a {
         Operand::Var(v) => Some((0, v.0)),
         Operand::Tmp(t) => Some((1, t)),
@@ -249,8 +256,7 @@ fn sin_cos_partners(sched: &Schedule, output_of: &[Option<Slot>]) -> Vec<Option<
     let mut seen: HashMap<(Func, (u8, u32)), usize> = HashMap::new();
     let mut partner = vec![None; sched.instrs.len()];
     for (k, instr) in sched.instrs.iter().enumerate() {
-        let (Op::Func(f @ (Func::Sin | Func::Cos)), Some(a), None) =
-            (instr.op, key(instr.args[0]), output_of[k])
+        let (Op::Func(f @ (Func::Sin | Func::Cos)), Some(a)) = (instr.op, key(instr.args[0]))
         else {
             continue;
         };

@@ -8,7 +8,7 @@
 //! `Span::mixed_site()`, so that nothing the macro binds can capture a name
 //! of the user's crate. Printed names are distinct anyway ([`Names`]).
 
-use moreau_sym::Op;
+use moreau_sym::{Func, Op};
 use proc_macro2::{Delimiter, Group, Ident, Literal, Punct, Spacing, Span, TokenStream, TokenTree};
 use quote::{ToTokens, quote};
 
@@ -39,6 +39,13 @@ pub(crate) trait Sink {
     fn op(&mut self, op: char, unary: bool);
     /// `.name(` args `)`.
     fn method(&mut self, name: &str, args: &mut dyn FnMut(&mut Self));
+    /// `sin a`, `cos a` or the pair `(sin a, cos a)` (`name` `"sin"`,
+    /// `"cos"`, `"sin_cos"`) of the operand `a`: `name(a)`, the runtime's
+    /// function of that name for the model's scalar (one implementation of
+    /// each for `f64` and `f32`, so a sine is the same bits whether it was
+    /// computed alone or in a pair), `a.name()` for an enclosure (`a`
+    /// parenthesised where a method would bind tighter: `wrap`).
+    fn trig(&mut self, name: &str, a: &mut dyn FnMut(&mut Self), wrap: bool);
     /// `(` inner `)`.
     fn paren(&mut self, inner: &mut dyn FnMut(&mut Self));
     /// A part of a long body: `let [outs] = part([ins]);` around a nested
@@ -87,14 +94,20 @@ pub(crate) fn code<S: Sink>(s: &mut S, names: &Names, model: &Resolved<'_>, code
             operand(s, a, a.precedence() < 4);
             s.method("powi", &mut |s| s.int(*n));
         }
+        Code::Func(f @ (Func::Sin | Func::Cos), a) => s.trig(
+            f.name(),
+            &mut |s| self::code(s, names, model, a),
+            a.precedence() < 4,
+        ),
         Code::Func(f, a) => {
             operand(s, a, a.precedence() < 4);
             s.method(f.name(), &mut |_| {});
         }
-        Code::SinCos(a) => {
-            operand(s, a, a.precedence() < 4);
-            s.method("sin_cos", &mut |_| {});
-        }
+        Code::SinCos(a) => s.trig(
+            "sin_cos",
+            &mut |s| self::code(s, names, model, a),
+            a.precedence() < 4,
+        ),
         Code::Powf(a, b) | Code::Atan2(a, b) => {
             let name = if matches!(code, Code::Powf(..)) {
                 "powf"
@@ -389,6 +402,23 @@ impl Sink for Tokens {
         self.push(Ident::new(name, Span::call_site()));
         self.group(Delimiter::Parenthesis, args);
     }
+    fn trig(&mut self, name: &str, a: &mut dyn FnMut(&mut Self), wrap: bool) {
+        match self.1 {
+            Scalar::Model => {
+                let name = Ident::new(name, Span::call_site());
+                self.0.extend(quote!(::moreau::__private::#name));
+                self.group(Delimiter::Parenthesis, a);
+            }
+            Scalar::Enclosure => {
+                if wrap {
+                    self.group(Delimiter::Parenthesis, a);
+                } else {
+                    a(self);
+                }
+                self.method(name, &mut |_| {});
+            }
+        }
+    }
     fn paren(&mut self, inner: &mut dyn FnMut(&mut Self)) {
         self.group(Delimiter::Parenthesis, inner);
     }
@@ -505,6 +535,10 @@ impl Sink for Text {
         self.0.push('.');
         self.0.push_str(name);
         self.paren(args);
+    }
+    fn trig(&mut self, name: &str, a: &mut dyn FnMut(&mut Self), _wrap: bool) {
+        self.0.push_str(name);
+        self.paren(a);
     }
     fn paren(&mut self, inner: &mut dyn FnMut(&mut Self)) {
         self.0.push('(');

@@ -293,6 +293,13 @@ impl Env<'_> {
             .collect::<Result<_, _>>()?;
         match (f.as_str(), args.len()) {
             ("cst" | "ArrayStorage", 1) => Ok(args.remove(0)),
+            // the runtime's trigonometry for the model's scalar
+            ("sin", 1) => Ok(Value::Num(args.remove(0).num()?.sin())),
+            ("cos", 1) => Ok(Value::Num(args.remove(0).num()?.cos())),
+            ("sin_cos", 1) => {
+                let x = args.remove(0).num()?;
+                Ok(Value::Tuple(vec![Value::Num(x.sin()), Value::Num(x.cos())]))
+            }
             ("from_array_storage", 1) => {
                 let Value::Array(columns) = args.remove(0) else {
                     return Err("storage is not an array".into());
