@@ -646,15 +646,9 @@ where
         // samples that agree with each other, or an interval longer than
         // `max_interval`, restarts the filter from the measurement
         let fresh = report;
-        if let Plan::Restart(why) =
-            self.screen
-                .screen(&self.params.observer, (t, interval.tau), &self.q, q)?
-        {
-            let mut report = fresh;
-            let v = restart_velocity(&interval, &self.v, why, &mut report)?;
-            let (t1, q1) = (interval.t0 + interval.tau, interval.q1);
-            return Ok(self.restarted(t1, q1, v, report));
-        }
+        let plan = self
+            .screen
+            .screen(&self.params.observer, (t, interval.tau), &self.q, q)?;
         let sigma = rule.noise;
         interval.gain = if sigma > T::zero() {
             sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
@@ -666,17 +660,22 @@ where
         // PREDICT, the covariance following every piece and impact
         let mut propagation = Propagation::new(model, u, self.t, &self.params, self.p);
         let v0 = saturate(&self.v, self.params.observer.velocity_bound);
-        let (q_pred, v_pred) = match interval.predict_traced(&v0, &mut report, &mut propagation) {
+        let predicted = match plan {
+            Plan::Integrate => interval
+                .predict_traced(&v0, &mut report, &mut propagation)
+                .map_err(|_| Restart::Infeasible),
+            Plan::Restart(why) => Err(why),
+        };
+        let (q_pred, v_pred) = match predicted {
             Ok(end) => end,
-            // the model or an impact problem failed along the motion
-            // predicted from the filter's own state: start again from
-            // the measurement, as the observers do
-            Err(_) => {
+            // agreeing outliers, a long gap, or a prediction that failed
+            // from the filter's own state: start again from the
+            // measurement, as the observers do
+            Err(why) => {
                 let mut report = fresh;
-                let why = Restart::Infeasible;
                 let v = restart_velocity(&interval, &self.v, why, &mut report)?;
-                let (t1, q1) = (interval.t0 + interval.tau, interval.q1);
-                return Ok(self.restarted(t1, q1, v, report));
+                let end = (interval.t0 + interval.tau, interval.q1);
+                return Ok(self.restarted(end.0, end.1, v, report));
             }
         };
         let (q_pred, v_pred) = (
