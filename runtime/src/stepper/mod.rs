@@ -130,7 +130,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 use crate::error::DataError;
 use crate::lcp::{IndexSet, Lcp};
 use crate::linalg::{Cholesky, Lu};
-use crate::model::Model;
+use crate::model::{Linearization, Model};
 use crate::state::State;
 use crate::validate;
 
@@ -309,7 +309,10 @@ impl<T: RealField + Copy> MoreauJean<T> {
         }
         // WRITEBACK: only a finite result replaces the caller's state
         let (q, v) = iterate;
-        if !(q.iter().chain(v.iter()).all(|x| x.is_finite()) && start.t_next.is_finite()) {
+        if !(q.iter().all(|x| x.is_finite())
+            && v.iter().all(|x| x.is_finite())
+            && start.t_next.is_finite())
+        {
             return Err(DataError::NonFiniteResult.into());
         }
         *state = State::new(start.t_next, q, v);
@@ -364,8 +367,15 @@ impl<T: RealField + Copy> MoreauJean<T> {
         finite_matrix(&gaps, "h")?;
         finite_matrix(&jac, "J")?;
         let normal_velocity = jac * v;
-        let forces = model.forces(t, &q, &v, u);
-        finite_matrix(&forces, "F")?;
+        // F(t_k, q_k, v_k) enters only the θ-method's residual; the midpoint
+        // step evaluates F at the θ-point alone
+        let forces = if self.params.approach_velocity == ApproachVelocity::Midpoint {
+            SVector::zeros()
+        } else {
+            let forces = model.forces(t, &q, &v, u);
+            finite_matrix(&forces, "F")?;
+            forces
+        };
         Ok(Start {
             t,
             t_next,
@@ -396,16 +406,44 @@ impl<T: RealField + Copy> MoreauJean<T> {
         // the point M, F and J are evaluated at: the iterate (q̃, ṽ), or the
         // θ-point of the step for the midpoint law
         let (t_e, q_e, v_e) = self.evaluation_point(start, &q, &v);
-        let lin = model.linearization(t_e, &q_e, &v_e, u);
-        let mass = check_mass(&lin.mass)?;
+        let lin = if explicit_forces::<M, N, K>() {
+            // ∂F/∂q = ∂F/∂v = 0 by the model's structure: W = M, and the
+            // model need not compute the Jacobians
+            let (mass, forces) = model.dynamics(t_e, &q_e, &v_e, u);
+            Linearization {
+                mass,
+                forces,
+                forces_dq: SMatrix::zeros(),
+                forces_dv: SMatrix::zeros(),
+            }
+        } else {
+            model.linearization(t_e, &q_e, &v_e, u)
+        };
+        let w = if explicit_forces::<M, N, K>() && M::STRUCTURE.mass_diagonal {
+            Factor::Diagonal(check_diagonal_mass(&lin.mass)?)
+        } else {
+            let mass = check_mass(&lin.mass)?;
+            iteration_matrix(&lin.mass, mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?
+        };
         finite_matrix(&lin.forces, "F")?;
-        let w = iteration_matrix(&lin.mass, mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?;
         // FREE VELOCITY: v_free = ṽ − W⁻¹ R(q̃, ṽ)
         let forces = self.step_forces(model, start, &q_e, &v, lin.forces);
         finite_matrix(&forces, "C")?;
         let residual = lin.mass * (v - start.v) + self.force_impulse(start, &forces);
         let v_free = v - solve(&w, &residual)?;
-        // IMPULSES: Newton's law compares J v_{k+1} with the restitution term
+        // IMPULSES: Newton's law compares J v_{k+1} with the restitution
+        // term; with no constraint in the index set there is nothing to
+        // compare (J(q_k) was checked finite at the start)
+        if start.active.is_empty() {
+            let v_next = v_free;
+            return Ok(Iterate {
+                q: update_position(&start.q, &start.v, &v_next, tau, theta),
+                v: v_next,
+                jacobian: SMatrix::zeros(),
+                impulse: Impulse::none(),
+                dynamics: (lin.mass, lin.forces),
+            });
+        }
         let jac = model.gap_jacobian(&q_e);
         finite_matrix(&jac, "J")?;
         let restitution_term = match self.params.approach_velocity {
@@ -430,6 +468,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
             v: v_next,
             jacobian: jac,
             impulse,
+            dynamics: (lin.mass, lin.forces),
         })
     }
 
@@ -462,7 +501,9 @@ impl<T: RealField + Copy> MoreauJean<T> {
     where
         M: Model<N, K, Scalar = T>,
     {
-        if self.params.approach_velocity != ApproachVelocity::Midpoint {
+        // with M constant the Christoffel symbols, and so C, vanish
+        if self.params.approach_velocity != ApproachVelocity::Midpoint || M::STRUCTURE.mass_constant
+        {
             return forces;
         }
         let jump = v - start.v;
@@ -503,7 +544,13 @@ impl<T: RealField + Copy> MoreauJean<T> {
         M: Model<N, K, Scalar = T>,
     {
         let (t_e, q_e, v_e) = self.evaluation_point(start, &next.q, &next.v);
-        let (mass, forces) = model.dynamics(t_e, &q_e, &v_e, u);
+        // M constant and F free of q and v: the evaluation at the new
+        // iterate (same time, same input) gives what the iteration had
+        let (mass, forces) = if explicit_forces::<M, N, K>() && M::STRUCTURE.mass_constant {
+            next.dynamics
+        } else {
+            model.dynamics(t_e, &q_e, &v_e, u)
+        };
         // a non-finite term makes the residual NaN: not converged, and the
         // next iteration reports it
         let forces = self.step_forces(model, start, &q_e, &next.v, forces);
@@ -550,7 +597,8 @@ struct Start<T: RealField + Copy, const N: usize, const K: usize> {
     v: SVector<T, N>,
     /// `J(q_k) v_k`.
     normal_velocity: SVector<T, K>,
-    /// `F(t_k, q_k, v_k)`.
+    /// `F(t_k, q_k, v_k)` for the θ-method (zero, and unused, for the
+    /// midpoint step).
     forces: SVector<T, N>,
     restitution: SVector<T, K>,
     /// The index set of the step.
@@ -561,9 +609,12 @@ struct Start<T: RealField + Copy, const N: usize, const K: usize> {
 struct Iterate<T: RealField + Copy, const N: usize, const K: usize> {
     q: SVector<T, N>,
     v: SVector<T, N>,
-    /// `J` at the iterate the impulses acted at.
+    /// `J` at the iterate the impulses acted at (zero when no constraint
+    /// is in the index set).
     jacobian: SMatrix<T, K, N>,
     impulse: Impulse<T, N, K>,
+    /// `(M, F)` at the evaluation point of this iteration.
+    dynamics: (SMatrix<T, N, N>, SVector<T, N>),
 }
 
 /// The outcome of the impact stage.
@@ -612,8 +663,20 @@ pub fn predict_index_set<T: RealField + Copy, const K: usize>(
     set
 }
 
+/// Whether the model's structure proves `∂F/∂q = 0` and `∂F/∂v = 0`, so
+/// that the step treats its forces explicitly (`W = M`) without asking the
+/// model for the Jacobians.
+const fn explicit_forces<M: Model<N, K>, const N: usize, const K: usize>() -> bool {
+    M::STRUCTURE.forces_configuration_free && M::STRUCTURE.forces_velocity_free
+}
+
 /// A factored iteration matrix `W`.
 enum Factor<T: RealField + Copy, const N: usize> {
+    /// `W = M` diagonal (the model's structure proves it, and that the
+    /// forces depend on neither `q` nor `v`): its diagonal. A solve is one
+    /// division per coordinate, correctly rounded, where the Cholesky
+    /// route takes a square root and two divisions in a chain.
+    Diagonal(SVector<T, N>),
     /// `W = M` (forces that depend on neither `q` nor `v`): the Cholesky
     /// factor the mass check already computed.
     Mass(Cholesky<T, N>),
@@ -622,8 +685,10 @@ enum Factor<T: RealField + Copy, const N: usize> {
 }
 
 /// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored; `mass` is the Cholesky factor
-/// of `M`, reused when both Jacobians vanish.
-#[inline]
+/// of `M`, reused when both Jacobians vanish. (Inlined: returned through
+/// memory from a call, its factor costs a store-forwarding stall at the
+/// first load.)
+#[inline(always)]
 fn iteration_matrix<T: RealField + Copy, const N: usize>(
     m: &SMatrix<T, N, N>,
     mass: Cholesky<T, N>,
@@ -645,11 +710,19 @@ fn iteration_matrix<T: RealField + Copy, const N: usize>(
 }
 
 /// `W⁻¹ x`.
+#[inline(always)]
 fn solve<T: RealField + Copy, const N: usize, const C: usize>(
     w: &Factor<T, N>,
     x: &SMatrix<T, N, C>,
 ) -> Result<SMatrix<T, N, C>, StepError<T>> {
     let x = match w {
+        Factor::Diagonal(d) => {
+            let mut x = *x;
+            for mut column in x.column_iter_mut() {
+                column.component_div_assign(d);
+            }
+            x
+        }
         Factor::Mass(chol) => chol.solve(x),
         Factor::Lu(lu) => lu.solve(x),
     };
@@ -725,6 +798,20 @@ where
     validate::model_and_input(model, u)?;
     validate::restitution(&model.restitution())?;
     Ok(())
+}
+
+/// Checks that a diagonal `M` is finite and positive definite and returns
+/// its diagonal (the same errors as [`validate::factor_mass`]).
+fn check_diagonal_mass<T: RealField + Copy, const N: usize>(
+    m: &SMatrix<T, N, N>,
+) -> Result<SVector<T, N>, StepError<T>> {
+    finite_matrix(m, "M")?;
+    let d = m.diagonal();
+    if d.iter().all(|x| *x > T::zero()) {
+        Ok(d)
+    } else {
+        Err(DataError::MassNotPositiveDefinite.into())
+    }
 }
 
 /// Checks that `M` is positive definite and returns its Cholesky factor
