@@ -800,6 +800,118 @@ fn example_1_figures_beside_the_reduced_order_observer() {
     }
 }
 
+/// Random Example 1 starts whose exact solution ([`common::exact`]) does
+/// not accumulate within 10 s: `(start, exact run)` for `count` draws of
+/// `x ∈ [−1, 1]`, a height `0.5` to `4.5` above the parabola,
+/// `v ∈ [−3, 3]²`.
+fn exact_starts(seed: u64, count: usize) -> Vec<((Vector2<f64>, Vector2<f64>), Reference<2>)> {
+    let mut g = Gauss::new(seed);
+    (0..count)
+        .filter_map(|_| {
+            let x = 2.0 * g.uniform() - 1.0;
+            let y = x * x + 0.5 + 4.0 * g.uniform();
+            let v = Vector2::new(6.0 * g.uniform() - 3.0, 6.0 * g.uniform() - 3.0);
+            let start = (Vector2::new(x, y), v);
+            common::exact::parabola(start, 10.0, 1e-3).map(|run| (start, run))
+        })
+        .collect()
+}
+
+/// The targets where the truth is exact: Example 1 solved event
+/// by event in closed form ([`common::exact`], checked here against the
+/// plant at `τ = 1e-6` up to its third impact), `σ = 1e-4` at 1 kHz,
+/// `v̂(0) = 0`, scored over `[2, 10]` s. The knobs are picked by
+/// [`tune_process_noise`] from one such record (a start and noise of its
+/// own) and used unchanged on six random starts drawn apart (the starts
+/// of 40 draws whose impacts do not accumulate: the closed form does not
+/// cover sliding).
+///
+/// Asserted on every run: median ≤ 3e-5, 90th percentile ≤ 2e-4 and,
+/// off the two samples bracketing each impact, maximum ≤ 1e-2 m/s.
+///
+/// The same filter on the plant's runs misses these on some starts (see
+/// `example_1_figures_beside_the_reduced_order_observer`); this test shows
+/// where that gap comes from. The plant at `τ = 1e-5` places each impact
+/// somewhere inside its step, and so within about `τ/√12` in time of the
+/// exact one; after an impact on the curved floor at several m/s that is
+/// a velocity error of `1e-4` to `1e-3` m/s that no model of the exact
+/// dynamics predicts, so the likelihood asks for impact noise there
+/// (`σ_t = 3e-6` s by default), and every impact then costs the estimate
+/// the samples it takes to pin the new velocity down. On exact data the
+/// tuner finds that noise absent and the targets hold.
+#[test]
+fn example_1_targets_hold_on_exact_event_driven_data() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    // the closed form against the plant at τ = 1e-6, to the third impact
+    let (start, exact) = exact_starts(4242, 40).remove(0);
+    let until = exact.impacts[2].0;
+    let plant = reference(&model, start, 1e-6, 1000, until, &u);
+    for (a, b) in exact.samples.iter().zip(&plant.samples) {
+        assert!((a.t - b.t).abs() < 1e-12);
+        assert!(
+            (a.q - b.q).norm() < 1e-4,
+            "t = {}: q {} vs {}",
+            a.t,
+            a.q,
+            b.q
+        );
+        assert!(
+            (a.v - b.v).norm() < 1e-2,
+            "t = {}: v {} vs {}",
+            a.t,
+            a.v,
+            b.v
+        );
+    }
+    // the knobs from one record of its own
+    let (_, record) = exact_starts(99, 40).remove(0);
+    let measured = measure(&record, 1e-4, 77);
+    let t: Vec<f64> = record.samples.iter().map(|s| s.t).collect();
+    let tuned = tune_process_noise::<_, _, 2, 2>(
+        &model,
+        KalmanParams::new(20.0, 1e-4),
+        &t,
+        &measured,
+        &Vector2::zeros(),
+        &u,
+        (-4.0, 2.0),
+    )
+    .unwrap();
+    eprintln!(
+        "exact data, tuned on one record: q_a {:.3e}, ρ_i {:.3e}, σ_t {:.3e}, ρ_c {:.3e}",
+        tuned.params.accel_noise[0],
+        tuned.params.impact_noise,
+        tuned.params.impact_time_sigma,
+        tuned.params.contact_noise
+    );
+    let runs = exact_starts(4242, 40);
+    assert!(runs.len() >= 5, "{} runs", runs.len());
+    for (n, ((q0, v0), data)) in runs.iter().enumerate() {
+        let measured = measure(data, 1e-4, 5000 + n as u64);
+        let mut f =
+            SaltationKalman::<f64, 2, 2>::new(tuned.params, 0.0, measured[0], Vector2::zeros())
+                .unwrap();
+        let est = run(&mut f, &model, data, &measured, &u);
+        let sc = score(data, &est, (2.0, 10.0 + 1e-3));
+        eprintln!(
+            "exact run {n}, from ({:.2}, {:.2}) at ({:.2}, {:.2}), {} impacts: median {:.2e} p90 {:.2e} max {:.2e}, without the bracketing samples {:.2e}",
+            q0[0],
+            q0[1],
+            v0[0],
+            v0[1],
+            data.impacts.len(),
+            sc.all.median,
+            sc.all.p90,
+            sc.all.max,
+            sc.clean.max
+        );
+        assert!(sc.all.median <= 3e-5, "run {n}: median {:e}", sc.all.median);
+        assert!(sc.all.p90 <= 2e-4, "run {n}: p90 {:e}", sc.all.p90);
+        assert!(sc.clean.max <= 1e-2, "run {n}: max {:e}", sc.clean.max);
+    }
+}
+
 // ---------------------------------------------------------------------------
 // Numerical care, reproducibility, bad data
 

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod casadi;
+pub mod exact;
 pub mod runs;
 
 use std::path::PathBuf;
