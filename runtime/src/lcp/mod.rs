@@ -192,7 +192,7 @@ impl<T: RealField + Copy> Lcp<T> {
     /// round-off whatever `τ` is.
     #[must_use]
     pub fn default_tolerance() -> T {
-        T::default_epsilon().cbrt()
+        crate::linalg::cbrt_epsilon()
     }
 
     /// Solves `w = Wλ + b, 0 ≤ λ ⊥ w ≥ 0` on the rows and columns in

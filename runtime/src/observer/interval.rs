@@ -83,12 +83,17 @@ fn clearly_open<T: RealField + Copy>(h: T, row_norm_squared: T, band: T) -> bool
 ///   ([`Structure::mass_constant`](crate::Structure::mass_constant)), `M`
 ///   and its Cholesky factor, reused while `M` evaluates to the same bits
 ///   (a parameter changed through `parameter_mut` gives another `M`, and a
-///   new factorization).
+///   new factorization);
+/// * for a model whose `F` also depends on none of `t`, `q`, `v`, `u`,
+///   the free acceleration `−M⁻¹F` with that factor, reused while `F`
+///   evaluates to the same bits.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Cache<T: RealField + Copy, const N: usize> {
     gains: [(T, T); 4],
     next: usize,
     mass: Option<(SMatrix<T, N, N>, Cholesky<T, N>)>,
+    /// `(F, −M⁻¹F)` for the factor in `mass` (cleared with it).
+    accel: Option<(SVector<T, N>, SVector<T, N>)>,
 }
 
 impl<T: RealField + Copy, const N: usize> Default for Cache<T, N> {
@@ -98,6 +103,7 @@ impl<T: RealField + Copy, const N: usize> Default for Cache<T, N> {
             gains: [(T::zero(), T::zero()); 4],
             next: 0,
             mass: None,
+            accel: None,
         }
     }
 }
@@ -137,11 +143,51 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
         match self.mass {
             Some((key, chol)) if key == mass => Some(chol),
             _ => {
+                self.accel = None;
                 let chol = factor_mass(&mass).ok()?;
                 self.mass = Some((mass, chol));
                 Some(chol)
             }
         }
+    }
+
+    /// For a model whose `F` depends on none of `t`, `q`, `v`, `u`, with `M`
+    /// factored as `chol` (constant, from [`mass`](Self::mass)): the free
+    /// acceleration `−M⁻¹F`, the same bits at every point, from the memo
+    /// while `F` is unchanged (`None` for another model, or a non-finite
+    /// `F`).
+    #[inline]
+    fn constant_free<M, const K: usize>(
+        &mut self,
+        model: &M,
+        u: &M::Input,
+        t: T,
+        q: &SVector<T, N>,
+        chol: Cholesky<T, N>,
+    ) -> Option<Free<T, N>>
+    where
+        M: Model<N, K, Scalar = T>,
+    {
+        let s = M::STRUCTURE;
+        let constant = s.mass_constant
+            && s.forces_velocity_free
+            && s.forces_configuration_free
+            && s.forces_time_free
+            && s.forces_input_free;
+        if !constant {
+            return None;
+        }
+        let forces = model.forces(t, q, &SVector::zeros(), u);
+        finite(&forces, "F").ok()?;
+        let accel = match self.accel {
+            Some((key, accel)) if key == forces => accel,
+            _ => {
+                let accel = -chol.solve(&forces);
+                self.accel = Some((forces, accel));
+                accel
+            }
+        };
+        Some(Free { chol, accel })
     }
 }
 
@@ -154,37 +200,6 @@ pub(crate) fn check_contact<T: RealField + Copy, const N: usize, const K: usize>
     finite(h, "h")?;
     finite(jac, "J")?;
     Ok(())
-}
-
-/// For a model whose `F` depends on none of `t`, `q`, `v`, `u`, with `M`
-/// factored as `chol` (constant): the free acceleration `−M⁻¹F`, the same
-/// bits at every point (`None` for another model, or a non-finite `F`).
-fn constant_free<M, T, const N: usize, const K: usize>(
-    model: &M,
-    u: &M::Input,
-    t: T,
-    q: &SVector<T, N>,
-    chol: Cholesky<T, N>,
-) -> Option<Free<T, N>>
-where
-    T: RealField + Copy,
-    M: Model<N, K, Scalar = T>,
-{
-    let s = M::STRUCTURE;
-    let constant = s.mass_constant
-        && s.forces_velocity_free
-        && s.forces_configuration_free
-        && s.forces_time_free
-        && s.forces_input_free;
-    if !constant {
-        return None;
-    }
-    let forces = model.forces(t, q, &SVector::zeros(), u);
-    finite(&forces, "F").ok()?;
-    Some(Free {
-        chol,
-        accel: -chol.solve(&forces),
-    })
 }
 
 /// The mass matrix factored and the free acceleration `−M⁻¹ F̄` at one
@@ -361,7 +376,8 @@ where
         validate::restitution(&restitution)?;
         let gain = cache.gain(memory.params.l_d, tau);
         let mass = cache.mass::<M, K>(model, &memory.q);
-        let constant = mass.and_then(|chol| constant_free(model, u, memory.t, &memory.q, chol));
+        let constant =
+            mass.and_then(|chol| cache.constant_free::<M, K>(model, u, memory.t, &memory.q, chol));
         let interval = Interval {
             model,
             u,
@@ -505,7 +521,7 @@ where
         if n == T::zero() {
             return Ok(SVector::zeros());
         }
-        let delta = T::default_epsilon().cbrt() * p.amax().max(T::one());
+        let delta = crate::linalg::cbrt_epsilon::<T>() * p.amax().max(T::one());
         let d = w / n;
         let plus = self.model.gap_jacobian(&(p + d * delta));
         let minus = self.model.gap_jacobian(&(p - d * delta));
@@ -542,6 +558,37 @@ where
         report.lcp_residual = report.lcp_residual.max(solution.residual);
         report.active = report.active.union(sliding);
         Ok((free.accel + minv_jt * solution.lambda, solution.lambda))
+    }
+
+    /// The motion over `[s0, s0 + h]` from `start`, with the persistent
+    /// contacts `sliding` held: [`rk4`](Self::rk4). In free flight under a
+    /// constant acceleration `a` (the interval's `constant`) the four
+    /// stages all take `a`, and the same arithmetic is done here, inlined,
+    /// without the calls for the stages (the same bits: `tests/memo.rs`).
+    #[inline(always)]
+    fn advance(
+        &self,
+        start: &Point<'_, T, N>,
+        h: T,
+        sliding: IndexSet<K>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<Arc<T, N, K>, T> {
+        if !(sliding.is_empty() && self.constant.is_some()) {
+            return self.rk4(start, h, sliding, report);
+        }
+        // the three further stages' points, served by the memo
+        report.evaluations += 3;
+        let (p0, w0, a) = (start.p, start.w, start.free.accel);
+        let half = h * nalgebra::convert::<f64, T>(0.5);
+        let two: T = nalgebra::convert(2.0);
+        let sixth = h / nalgebra::convert(6.0);
+        let w2 = w0 + a * half;
+        let w4 = w0 + a * h;
+        Ok(Arc {
+            p: p0 + (w0 + w2 * two + w2 * two + w4) * sixth,
+            w: w0 + (a + a * two + a * two + a) * sixth,
+            impulse: SVector::zeros(),
+        })
     }
 
     /// Classical fourth-order Runge–Kutta for `p' = w`, `w' = a(s, p, w)`
@@ -625,6 +672,7 @@ where
     /// restitution only when it approaches faster than
     /// `v_rest,i + g_i u`, with `u` the estimate's [`uncertainty`](Self::uncertainty):
     /// slower, it is closed plastically.
+    #[inline(always)]
     fn classify(
         &self,
         at: &Point<'_, T, N>,

@@ -138,7 +138,7 @@ where
             if rest <= T::zero() {
                 return Ok((p, w));
             }
-            let arc = self.rk4(&point, rest, c.sliding, report)?;
+            let arc = self.advance(&point, rest, c.sliding, report)?;
             report.contacts = report.contacts.union(c.sliding);
             // SEARCH for the first closing constraint along it
             if !last_round && report.impacts < max_impacts {
@@ -157,7 +157,7 @@ where
                 if let Some(Crossing { at, set }) =
                     self.first_crossing(&seg, &c, (&jac, band), (&h, &rate0), (&h1, &rate1))?
                 {
-                    let part = self.rk4(&point, at, c.sliding, report)?;
+                    let part = self.advance(&point, at, c.sliding, report)?;
                     tracer.flight(&Flight {
                         s0: s,
                         h: at,
