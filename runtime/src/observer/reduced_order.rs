@@ -408,7 +408,8 @@ where
             restitution: self.restitution.as_ref(),
             report: &self.report,
         };
-        let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
+        let (mut interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
+        interval.release_departures = true;
         // SCREEN: an outlier is refused here, the estimate untouched
         let plan = self
             .outliers
