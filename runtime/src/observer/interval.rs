@@ -16,7 +16,9 @@ use crate::validate::{self, factor_mass, finite_model as finite};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
+mod retime;
 mod traced;
+pub(crate) use retime::Impacts;
 pub(crate) use traced::{Flight, Jump, Tracer};
 
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
