@@ -95,10 +95,22 @@ fn check<M, const N: usize, const K: usize>(
 /// start over the seeds: 0.40, 0.17, 0.0056, 0.31), with the error above
 /// 1e-2 for up to 94 samples after an impact of the accumulation.
 ///
+/// With the impacts confirmed by the sample after them and slow
+/// separations no longer held as contacts (measured on these twelve runs):
+/// median 1.23e-3 to 1.36e-3 (0.87 to 0.96 ×), 90th percentile 2.30e-3
+/// to 2.89e-3 (1.63 to 2.04 ×), maximum 4.8e-3 to 1.03 m/s, and without
+/// the bracketing samples 4.8e-3 to 0.098 m/s (worst per start 0.098,
+/// 0.051, 0.0055, 0.054), with the error above 1e-2 for up to 47 samples
+/// after an impact of the accumulation. Before these two changes (the
+/// smoothed position alone): median 1.23e-3 to 1.90e-3, 90th percentile
+/// 2.31e-3 to 3.59e-3, and without the bracketing samples up to 0.27 m/s
+/// (above 0.1 on 5 runs of 12).
+///
 /// Asserted on every run: median and 90th percentile within the baseline's
 /// worst (`1.4` and `3` × √2 l_d σ), and without the bracketing samples a
-/// maximum of at most `0.3` m/s. The target for that maximum,
-/// `0.1` m/s, is not reached on every run: see the figures printed.
+/// maximum of at most `0.1` m/s, the target (the worst run, the
+/// file's start with seed 11, is at 0.098: this is a bound met, not one
+/// with room to spare).
 #[test]
 fn example_1_under_noise() {
     let model = Parabola::<f64>::new();
@@ -109,7 +121,7 @@ fn example_1_under_noise() {
             &model,
             start,
             &seeds,
-            (1.4, 3.0, 0.3),
+            (1.4, 3.0, 0.1),
         );
     }
 }
@@ -123,9 +135,14 @@ fn example_1_under_noise() {
 /// 90th percentile 3.43e-3 to 3.51e-3, without the bracketing samples max
 /// 5.3e-2; double pendulum median 2.30e-3 to 2.34e-3 (1.65 ×), 90th
 /// percentile 3.90e-3 to 4.02e-3 (2.84 ×), without the bracketing samples
-/// max 0.11 to 0.18. Asserted: median and 90th percentile within `1.7` and
-/// `3` × √2 l_d σ, and without the bracketing samples a maximum of at most
-/// `0.1` m/s.
+/// max 0.11 to 0.18. With the impacts confirmed by the sample after them
+/// (measured): three balls unchanged (median 1.94e-3 to 1.98e-3, 90th
+/// percentile 3.43e-3 to 3.52e-3, max 5.3e-2); double pendulum median
+/// 1.32e-3 to 1.38e-3 (0.98 ×; 2.19e-3 to 2.24e-3 with the smoothed
+/// position alone), 90th percentile 2.78e-3 to 2.87e-3 (2.03 ×; 3.73e-3
+/// to 3.81e-3), without the bracketing samples max 2.6e-2. Asserted: median
+/// and 90th percentile within `1.7` and `3` × √2 l_d σ, and without the
+/// bracketing samples a maximum of at most `0.1` m/s.
 #[test]
 fn other_models_under_noise() {
     let balls = ThreeBalls::<f64>::new();

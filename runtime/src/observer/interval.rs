@@ -16,7 +16,9 @@ use crate::validate::{self, factor_mass, finite_model as finite};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
+mod retime;
 mod traced;
+pub(crate) use retime::Impacts;
 pub(crate) use traced::{Flight, Jump, Tracer};
 
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto
@@ -336,6 +338,16 @@ where
     /// model, or when `F` is not finite: the stages then evaluate it and
     /// report the failure where they always did).
     pub constant: Option<Free<T, N>>,
+    /// Whether a closed constraint separating slower than its resting
+    /// speed but faster than that speed without the band's fall term
+    /// `√(4 A_i g_i b)` is departing (free, watched for a return) instead
+    /// of a persistent contact (`false` from [`begin`](Self::begin)). The
+    /// fall term bounds how fast a sample that noise put outside the band
+    /// falls back in; a separation is no such fall, and held at
+    /// acceleration level it keeps its normal speed over the whole
+    /// interval instead of losing `A_i τ` of it. The same rule when
+    /// `σ = 0` (the band is then `d` alone).
+    pub release_departures: bool,
 }
 
 /// What an observer remembers between updates, as the interval needs it.
@@ -392,6 +404,7 @@ where
             gain,
             mass,
             constant,
+            release_departures: false,
         };
         let mut report = UpdateReport::new(t, tau);
         report.gain = gain;
@@ -714,6 +727,15 @@ where
                 + (four * normal_accel * g * band).sqrt()
                 + g * noise_speed
                 + floor;
+            // separating: see `release_departures`
+            let depart = if self.release_departures {
+                self.params.rest_factor * self.tau * normal_accel
+                    + (four * normal_accel * g * self.params.contact_distance).sqrt()
+                    + g * noise_speed
+                    + floor
+            } else {
+                rest
+            };
             if jw < -rest && h[i] > T::zero() && !touched.contains(i) {
                 // a fast approach still outside: its root along the
                 // predicted motion says when it closes (the band only
@@ -731,7 +753,7 @@ where
                 if jw < -(rest + g * self.uncertainty) {
                     c.elastic.insert(i);
                 }
-            } else if jw <= rest {
+            } else if jw <= depart {
                 c.sliding.insert(i);
             } else {
                 c.departing.insert(i);

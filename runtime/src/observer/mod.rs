@@ -186,7 +186,15 @@
 //! - a closed constraint with `|J_i w| ≤ v_rest` is a **persistent
 //!   contact** (sliding, resting), held at acceleration level;
 //! - a closed constraint separating faster than `v_rest` is **departing**:
-//!   free, but watched for a return within the interval.
+//!   free, but watched for a return within the interval. For the
+//!   reduced-order observer (38) the separating speed is compared with
+//!   `v_rest` without its band term `√(4 A_i g_i b)` (that term bounds a
+//!   sample falling back into the band, not a separation, and a slow
+//!   separation held as a persistent contact keeps its normal speed over
+//!   the whole interval instead of losing `A_i τ` of it): under noise a
+//!   rebound of a few tenths of a m/s in an accumulation flies and
+//!   decelerates instead of keeping its speed for an interval. With
+//!   `σ = 0` and `d = 0` the rule is the same.
 //!
 //! Along each piece of prediction: an open gap that ends closed has a root
 //! in between; an open gap that starts closing and ends opening is

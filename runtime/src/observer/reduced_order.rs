@@ -6,7 +6,7 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Cache, Interval, Memory, saturate, saturate_for};
+use super::interval::{Cache, Impacts, Interval, Memory, saturate, saturate_for};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
     UpdateReport, check_start,
@@ -42,13 +42,25 @@ use crate::validate::{self, factor_mass, finite_model};
 /// constraint is approached fast enough to bounce or is closed plastically,
 /// and the set `V(q̄_{k+1})` the estimate ends in.
 ///
+/// An impact located from `q̄_k` is then confirmed by the sample after
+/// it: the measured minus the predicted displacement says how far off the
+/// start was along the normal, weighed against the noise of `q̄_k` and of
+/// two samples, and the impact is timed again within the interval, its
+/// rebound changed as Newton's law changes it (see
+/// `runtime/src/observer/interval/retime.rs`; only an interval with one
+/// restituted impact, on one constraint, at the cost of one more
+/// evaluation of `M`, `F` and `J̇ w` there). And a closed constraint
+/// separating slower than its resting speed but faster than the
+/// estimate's noise is departing, not held (see the contact rule in
+/// `runtime/src/observer/mod.rs`).
+///
 /// The correction is unchanged: the injection is still the measured
 /// displacement minus the predicted one, `(q_{k+1} − q_k) − (p − q̄_k)`,
 /// times the gain of (38), so the error obeys the same `M dṽ = … − l_d M ṽ
 /// dt − (η − η̂)` and the guarantee (and the cost: one prediction per
-/// update) is kept; only where the impulse `η̂` acts moves, by at most the
-/// noise band. Without noise `q̄ = q` and the update is the one above, bit
-/// for bit.
+/// update) is kept; only where and when the impulse `η̂` acts moves (where
+/// by at most the noise band, when within the interval). Without noise `q̄ = q`, no
+/// impact is timed again, and the update is the one above, bit for bit.
 ///
 /// ```
 /// use moreau_runtime::{Model, ModelInfo, Observer, ObserverParams, ReducedOrder};
@@ -213,7 +225,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
             Discretization::ImpactAware => (|| {
                 // PREDICT from (q_k, v̂_k) (from q̄_k under noise), impacts
                 // inside the interval
-                let (p_end, w_end) = interval.predict(&v0, report)?;
+                let mut impacts = Impacts::new();
+                let (p_end, w_end) = interval.predict_traced(&v0, report, &mut impacts)?;
                 // INJECT l_d ∫(v − v̂) = the measured minus the predicted
                 // displacement, integrated exactly over τ
                 // (under noise the prediction starts from q̄_k, and the
@@ -225,6 +238,13 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
                 };
                 report.innovation = innovation;
                 let v = w_end + innovation * interval.gain;
+                // CONFIRM: an impact timed from the noisy start, timed
+                // again with the sample after it
+                let noise = (self.params.noise, interval.params.noise);
+                let v = match interval.retime(&impacts, &innovation, noise, report)? {
+                    Some(dv) => v + dv,
+                    None => v,
+                };
                 // CLOSE: v̂_e ∈ V(q̄_{k+1}) (V(q_{k+1}) without noise)
                 let end = smoothed(&self.params, interval.tau, &interval.q1, &p_end);
                 let v = if end == interval.q1 {
@@ -408,7 +428,8 @@ where
             restitution: self.restitution.as_ref(),
             report: &self.report,
         };
-        let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
+        let (mut interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
+        interval.release_departures = true;
         // SCREEN: an outlier is refused here, the estimate untouched
         let plan = self
             .outliers
