@@ -346,7 +346,8 @@ where
     /// falls back in; a separation is no such fall, and held at
     /// acceleration level it keeps its normal speed over the whole
     /// interval instead of losing `A_i τ` of it. The same rule when
-    /// `σ = 0` (the band is then `d` alone).
+    /// `σ = 0` (the band is then `d` alone). From [`Memory`]: set by the
+    /// reduced-order observer.
     pub release_departures: bool,
 }
 
@@ -361,6 +362,8 @@ pub(crate) struct Memory<'a, T: RealField + Copy, const N: usize, const K: usize
     pub restitution: Option<&'a SVector<T, K>>,
     /// The last update's report.
     pub report: &'a UpdateReport<T, N, K>,
+    /// [`Interval::release_departures`].
+    pub release_departures: bool,
 }
 
 impl<'a, M, T, const N: usize, const K: usize> Interval<'a, M, T, N, K>
@@ -404,7 +407,7 @@ where
             gain,
             mass,
             constant,
-            release_departures: false,
+            release_departures: memory.release_departures,
         };
         let mut report = UpdateReport::new(t, tau);
         report.gain = gain;

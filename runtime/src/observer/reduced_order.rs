@@ -224,9 +224,15 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         let result = match self.params.scheme {
             Discretization::ImpactAware => (|| {
                 // PREDICT from (q_k, v̂_k) (from q̄_k under noise), impacts
-                // inside the interval
+                // inside the interval; under noise they are recorded, to be
+                // confirmed below (the exact-sample update keeps the plain
+                // prediction, and its cost)
                 let mut impacts = Impacts::new();
-                let (p_end, w_end) = interval.predict_traced(&v0, report, &mut impacts)?;
+                let (p_end, w_end) = if self.params.noise > T::zero() {
+                    interval.predict_traced(&v0, report, &mut impacts)?
+                } else {
+                    interval.predict(&v0, report)?
+                };
                 // INJECT l_d ∫(v − v̂) = the measured minus the predicted
                 // displacement, integrated exactly over τ
                 // (under noise the prediction starts from q̄_k, and the
@@ -241,9 +247,13 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
                 // CONFIRM: an impact timed from the noisy start, timed
                 // again with the sample after it
                 let noise = (self.params.noise, interval.params.noise);
-                let v = match interval.retime(&impacts, &innovation, noise, report)? {
-                    Some(dv) => v + dv,
-                    None => v,
+                let v = if self.params.noise > T::zero() {
+                    match interval.retime(&impacts, &innovation, noise, report)? {
+                        Some(dv) => v + dv,
+                        None => v,
+                    }
+                } else {
+                    v
                 };
                 // CLOSE: v̂_e ∈ V(q̄_{k+1}) (V(q_{k+1}) without noise)
                 let end = smoothed(&self.params, interval.tau, &interval.q1, &p_end);
@@ -427,9 +437,9 @@ where
             q: self.smooth,
             restitution: self.restitution.as_ref(),
             report: &self.report,
+            release_departures: true,
         };
-        let (mut interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
-        interval.release_departures = true;
+        let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN: an outlier is refused here, the estimate untouched
         let plan = self
             .outliers

@@ -639,6 +639,7 @@ where
             q: self.q,
             restitution: self.restitution.as_ref(),
             report: &self.report,
+            release_departures: false,
         };
         let (mut interval, mut report) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN, as the observers do: a sample farther than the system
