@@ -86,11 +86,15 @@ fn updates(c: &mut Criterion) {
         // what the interval holds for each, checked before timing
         let mut probe = kalman;
         probe.update(&model, t, &q, &u).unwrap();
+        let mut probe_38 = reduced;
+        probe_38.update(&model, t, &q, &u).unwrap();
         eprintln!(
-            "{label} (interval ending at {t:.3} s): filter impacts {}, saltations {}, contacts {:?}",
+            "{label} (interval ending at {t:.3} s): filter impacts {}, saltations {}, contacts {:?}; (38) impacts {}, contacts {:?}",
             probe.report().impacts,
             probe.kalman_report().saltations,
-            probe.report().contacts
+            probe.report().contacts,
+            probe_38.report().impacts,
+            probe_38.report().contacts
         );
         // the estimator as it was before the update is copied outside the
         // timed region: a user updates in place and never copies it
