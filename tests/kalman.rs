@@ -800,11 +800,14 @@ fn example_1_figures_beside_the_reduced_order_observer() {
     }
 }
 
+/// An initial state `(q0, v0)` of Example 1.
+type Start = (Vector2<f64>, Vector2<f64>);
+
 /// Random Example 1 starts whose exact solution ([`common::exact`]) does
 /// not accumulate within 10 s: `(start, exact run)` for `count` draws of
 /// `x ∈ [−1, 1]`, a height `0.5` to `4.5` above the parabola,
 /// `v ∈ [−3, 3]²`.
-fn exact_starts(seed: u64, count: usize) -> Vec<((Vector2<f64>, Vector2<f64>), Reference<2>)> {
+fn exact_starts(seed: u64, count: usize) -> Vec<(Start, Reference<2>)> {
     let mut g = Gauss::new(seed);
     (0..count)
         .filter_map(|_| {
