@@ -667,6 +667,35 @@ fn nis_and_nees_are_chi_square_through_impacts() {
 // ---------------------------------------------------------------------------
 // Example 1 under noise
 
+/// The four knobs [`tune_process_noise`] picks for Example 1 from one
+/// record `data`, sampled with noise `sigma` (seed `seed`), printed.
+fn tuned_on(data: &Reference<2>, sigma: f64, seed: u64) -> KalmanParams<f64, 2> {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let measured = measure(data, sigma, seed);
+    let t: Vec<f64> = data.samples.iter().map(|s| s.t).collect();
+    let tuned = tune_process_noise::<_, _, 2, 2>(
+        &model,
+        KalmanParams::new(20.0, sigma),
+        &t,
+        &measured,
+        &Vector2::zeros(),
+        &u,
+        (-4.0, 2.0),
+    )
+    .unwrap();
+    eprintln!(
+        "tuned on one record: q_a {:.3e}, ρ_i {:.3e}, σ_t {:.3e}, ρ_c {:.3e}, log-likelihood {:.1}, {} runs",
+        tuned.params.accel_noise[0],
+        tuned.params.impact_noise,
+        tuned.params.impact_time_sigma,
+        tuned.params.contact_noise,
+        tuned.log_likelihood,
+        tuned.evaluations
+    );
+    tuned.params
+}
+
 /// The process noise for Example 1 picked by [`tune_process_noise`] from
 /// one recorded noisy run (the model file's initial state, its own noise
 /// seed), used unchanged on every other run.
@@ -681,28 +710,7 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
         10.0,
         &u,
     );
-    let measured = measure(&data, sigma, 1000);
-    let t: Vec<f64> = data.samples.iter().map(|s| s.t).collect();
-    let tuned = tune_process_noise::<_, _, 2, 2>(
-        &model,
-        KalmanParams::new(20.0, sigma),
-        &t,
-        &measured,
-        &Vector2::zeros(),
-        &u,
-        (-4.0, 2.0),
-    )
-    .unwrap();
-    eprintln!(
-        "tuned on one run: q_a {:.3e}, ρ_i {:.3e}, σ_t {:.3e}, ρ_c {:.3e}, log-likelihood {:.1}, {} runs",
-        tuned.params.accel_noise[0],
-        tuned.params.impact_noise,
-        tuned.params.impact_time_sigma,
-        tuned.params.contact_noise,
-        tuned.log_likelihood,
-        tuned.evaluations
-    );
-    tuned.params
+    tuned_on(&data, sigma, 1000)
 }
 
 /// Example 1 on four initial states (the model file's, whose impacts
@@ -869,32 +877,13 @@ fn example_1_targets_hold_on_exact_event_driven_data() {
     }
     // the knobs from one record of its own
     let (_, record) = exact_starts(99, 40).remove(0);
-    let measured = measure(&record, 1e-4, 77);
-    let t: Vec<f64> = record.samples.iter().map(|s| s.t).collect();
-    let tuned = tune_process_noise::<_, _, 2, 2>(
-        &model,
-        KalmanParams::new(20.0, 1e-4),
-        &t,
-        &measured,
-        &Vector2::zeros(),
-        &u,
-        (-4.0, 2.0),
-    )
-    .unwrap();
-    eprintln!(
-        "exact data, tuned on one record: q_a {:.3e}, ρ_i {:.3e}, σ_t {:.3e}, ρ_c {:.3e}",
-        tuned.params.accel_noise[0],
-        tuned.params.impact_noise,
-        tuned.params.impact_time_sigma,
-        tuned.params.contact_noise
-    );
+    let tuned = tuned_on(&record, 1e-4, 77);
     let runs = exact_starts(4242, 40);
     assert!(runs.len() >= 5, "{} runs", runs.len());
     for (n, ((q0, v0), data)) in runs.iter().enumerate() {
         let measured = measure(data, 1e-4, 5000 + n as u64);
         let mut f =
-            SaltationKalman::<f64, 2, 2>::new(tuned.params, 0.0, measured[0], Vector2::zeros())
-                .unwrap();
+            SaltationKalman::<f64, 2, 2>::new(tuned, 0.0, measured[0], Vector2::zeros()).unwrap();
         let est = run(&mut f, &model, data, &measured, &u);
         let sc = score(data, &est, (2.0, 10.0 + 1e-3));
         eprintln!(
