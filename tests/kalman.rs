@@ -13,7 +13,9 @@ use moreau::{
 };
 mod common;
 
-use common::runs::{Gauss, Reference, example_1_starts, figures, measure, reference, score};
+use common::runs::{
+    Gauss, Reference, example_1_run, example_1_starts, figures, measure, reference, score,
+};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
 
@@ -700,17 +702,7 @@ fn tuned_on(data: &Reference<2>, sigma: f64, seed: u64) -> KalmanParams<f64, 2> 
 /// one recorded noisy run (the model file's initial state, its own noise
 /// seed), used unchanged on every other run.
 fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
-    let model = Parabola::<f64>::new();
-    let u = SVector::zeros();
-    let data = reference(
-        &model,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        10.0,
-        &u,
-    );
-    tuned_on(&data, sigma, 1000)
+    tuned_on(&example_1_run(10.0), sigma, 1000)
 }
 
 /// Example 1 on four initial states (the model file's, whose impacts
@@ -925,14 +917,7 @@ fn assert_spd<const N: usize>(p: &Blocks<f64, N>, at: f64) {
 fn covariance_stays_symmetric_positive_definite_over_1e5_updates() {
     let model = Parabola::<f64>::new();
     let u = SVector::zeros();
-    let data = reference(
-        &model,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        100.0,
-        &u,
-    );
+    let data = example_1_run(100.0);
     let measured = measure(&data, 1e-4, 5);
     let params = KalmanParams::new(20.0, 1e-4);
     let mut f =
@@ -1193,16 +1178,7 @@ fn a_glitch_is_reported_and_skipped_not_absorbed() {
 #[test]
 fn runs_in_f32() {
     let model = Parabola::<f32>::new();
-    let model64 = Parabola::<f64>::new();
-    let u = SVector::zeros();
-    let data = reference(
-        &model64,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        10.0,
-        &u,
-    );
+    let data = example_1_run(10.0);
     let measured = measure(&data, 1e-3, 17);
     let q32: Vec<SVector<f32, 2>> = measured.iter().map(|q| q.cast::<f32>()).collect();
     let mut f = SaltationKalman::<f32, 2, 2>::new(

@@ -14,7 +14,7 @@ use moreau::{
 };
 mod common;
 
-use common::runs::{Figures, Reference, errors, figures, measure, reference, score};
+use common::runs::{Figures, Reference, errors, example_1_run, figures, measure, reference, score};
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 
@@ -94,14 +94,7 @@ fn full<const N: usize, const K: usize>(
 fn example_1_figures() {
     let model = Parabola::<f64>::new();
     let u = SVector::zeros();
-    let data = reference(
-        &model,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        10.0,
-        &u,
-    );
+    let data = example_1_run(10.0);
     let measured = measure(&data, 0.0, 0);
     let mut results = Vec::new();
     // the third run is a diagnostic, not asserted: the impact-aware scheme
@@ -481,14 +474,7 @@ fn smooth_decay_is_at_least_the_guaranteed_rate() {
     let zero = SVector::<f64, 0>::zeros();
     // Example 1 before its first impact (0.355 s)
     let parabola = Parabola::<f64>::new();
-    let data = reference(
-        &parabola,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        0.34,
-        &zero,
-    );
+    let data = example_1_run(0.34);
     assert!(data.impacts.is_empty());
     let bounds = bounds_along(&parabola, &data, 0.34, &zero);
     let v_hat0 = Vector2::zeros();
@@ -597,14 +583,7 @@ fn decays_at_the_guaranteed_rate<M>(
 fn restitution_mismatch_grows_the_error() {
     let model = Parabola::<f64>::new();
     let u = SVector::zeros();
-    let data = reference(
-        &model,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        4.45,
-        &u,
-    );
+    let data = example_1_run(4.45);
     let measured = measure(&data, 0.0, 0);
     let e = model.restitution();
     let mut curve = Vec::new();
@@ -683,14 +662,7 @@ fn below_the_latest_jump<const N: usize>(
 fn noise_sets_the_error_level() {
     let model = Parabola::<f64>::new();
     let u = SVector::zeros();
-    let data = reference(
-        &model,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        10.0,
-        &u,
-    );
+    let data = example_1_run(10.0);
     let l_d = 10.0;
     let mut curve = Vec::new();
     for sigma in [0.0, 1e-6, 1e-5, 1e-4, 1e-3] {
@@ -756,14 +728,7 @@ fn bits<const N: usize>(estimates: &[Estimate<f64, N>]) -> Vec<u64> {
 fn same_measurements_give_the_same_bits() {
     let u = SVector::zeros();
     let parabola = Parabola::<f64>::new();
-    let data = reference(
-        &parabola,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        6.0,
-        &u,
-    );
+    let data = example_1_run(6.0);
     let measured = measure(&data, 1e-4, 11);
     let billiard = Billiard::<f64>::new();
     let data_b = reference(
@@ -1199,16 +1164,8 @@ fn glued_balls_hit_the_wall_together_in_both_observers() {
 /// at 2 s, from 9.5 m/s).
 #[test]
 fn observers_run_in_f32() {
-    let model64 = Parabola::<f64>::default();
     let model32 = Parabola::<f32>::default();
-    let data = reference::<_, 2, 2>(
-        &model64,
-        Parabola::<f64>::initial_state(),
-        1e-5,
-        100,
-        10.0,
-        &SVector::zeros(),
-    );
+    let data = example_1_run(10.0);
     let params = ObserverParams::new(10.0_f32, 20.0);
     let q0: SVector<f32, 2> = data.samples[0].q.cast();
     let mut ro = ReducedOrder::<f32, 2, 2>::new(params, 0.0, q0, SVector::zeros()).unwrap();

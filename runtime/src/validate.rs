@@ -41,6 +41,21 @@ pub(crate) fn factor_mass<T: RealField + Copy, const N: usize>(
     Cholesky::new(mass).ok_or(DataError::MassNotPositiveDefinite)
 }
 
+/// The diagonal of a diagonal `M`, rejecting a non-finite or indefinite
+/// one with the errors of [`factor_mass`] (for a model whose structure
+/// proves `M` diagonal).
+pub(crate) fn diagonal_mass<T: RealField + Copy, const N: usize>(
+    mass: &SMatrix<T, N, N>,
+) -> Result<SVector<T, N>, DataError<T>> {
+    finite_model(mass, "M")?;
+    let d = mass.diagonal();
+    if d.iter().all(|x| *x > T::zero()) {
+        Ok(d)
+    } else {
+        Err(DataError::MassNotPositiveDefinite)
+    }
+}
+
 /// Rejects restitution coefficients outside `[0, 1]` (or NaN).
 pub(crate) fn restitution<T: RealField + Copy, const K: usize>(
     e: &SVector<T, K>,

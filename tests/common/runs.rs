@@ -195,6 +195,19 @@ pub fn score<const N: usize>(
     }
 }
 
+/// Example 1 from the model file's initial state to `t_end`: the plant at
+/// `τ = 1e-5`, sampled every 1 ms.
+pub fn example_1_run(t_end: f64) -> Reference<2> {
+    reference(
+        &Parabola::<f64>::new(),
+        Parabola::<f64>::initial_state(),
+        1e-5,
+        100,
+        t_end,
+        &SVector::zeros(),
+    )
+}
+
 /// Example 1's initial states: the model file's (impacts accumulate at
 /// 4.456 s and the mass slides on), and three more.
 pub fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {

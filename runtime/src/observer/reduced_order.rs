@@ -48,8 +48,8 @@ use crate::validate::{self, factor_mass, finite_model};
 /// two samples, and the impact is timed again within the interval, its
 /// rebound changed as Newton's law changes it (see
 /// `runtime/src/observer/interval/retime.rs`; only an interval with one
-/// restituted impact, on one constraint, at the cost of one more
-/// evaluation of `M`, `F` and `J̇ w` there). And a closed constraint
+/// restituted impact, on one constraint, at the cost of one more `J̇ w`
+/// there; `M`, `F` and `J` come from the prediction). And a closed constraint
 /// separating slower than its resting speed but faster than the
 /// estimate's noise is departing, not held (see the contact rule in
 /// `runtime/src/observer/mod.rs`).
@@ -248,7 +248,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
                 // again with the sample after it
                 let noise = (self.params.noise, interval.params.noise);
                 let v = if self.params.noise > T::zero() {
-                    match interval.retime(&impacts, &innovation, noise, report)? {
+                    match interval.retime(&impacts, &innovation, noise)? {
                         Some(dv) => v + dv,
                         None => v,
                     }

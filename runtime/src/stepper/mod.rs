@@ -420,7 +420,7 @@ impl<T: RealField + Copy> MoreauJean<T> {
             model.linearization(t_e, &q_e, &v_e, u)
         };
         let w = if explicit_forces::<M, N, K>() && M::STRUCTURE.mass_diagonal {
-            Factor::Diagonal(check_diagonal_mass(&lin.mass)?)
+            Factor::Diagonal(validate::diagonal_mass(&lin.mass)?)
         } else {
             let mass = check_mass(&lin.mass)?;
             iteration_matrix(&lin.mass, mass, &lin.forces_dq, &lin.forces_dv, tau, theta)?
@@ -798,20 +798,6 @@ where
     validate::model_and_input(model, u)?;
     validate::restitution(&model.restitution())?;
     Ok(())
-}
-
-/// Checks that a diagonal `M` is finite and positive definite and returns
-/// its diagonal (the same errors as [`validate::factor_mass`]).
-fn check_diagonal_mass<T: RealField + Copy, const N: usize>(
-    m: &SMatrix<T, N, N>,
-) -> Result<SVector<T, N>, StepError<T>> {
-    finite_matrix(m, "M")?;
-    let d = m.diagonal();
-    if d.iter().all(|x| *x > T::zero()) {
-        Ok(d)
-    } else {
-        Err(DataError::MassNotPositiveDefinite.into())
-    }
 }
 
 /// Checks that `M` is positive definite and returns its Cholesky factor

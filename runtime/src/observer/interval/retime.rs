@@ -26,12 +26,12 @@
 //! and so is the observer's error equation: the estimated impulse `η̂`
 //! still acts inside the interval, at a time the samples agree with better.
 
-use nalgebra::{RealField, SVector};
+use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::IndexSet;
 use crate::model::Model;
 
-use super::{Flight, Interval, Jump, Result, Tracer, UpdateReport};
+use super::{Flight, Free, Interval, Jump, Result, Tracer};
 
 /// A restituted impact on one constraint.
 #[derive(Clone, Copy)]
@@ -45,6 +45,9 @@ struct Impact<T: RealField + Copy, const N: usize> {
     /// The constraint `i` and its restitution `e_i`.
     i: usize,
     e: T,
+    /// `J_i(p)` and the free motion there, as the prediction had them.
+    row: SMatrix<T, 1, N>,
+    free: Free<T, N>,
 }
 
 /// What [`Interval::retime`] needs of the impacts of an interval: the
@@ -91,6 +94,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for Im
                     w: *jump.w_minus,
                     i,
                     e: jump.restitution[i],
+                    row: jump.jac.row(i).into_owned(),
+                    free: *jump.free,
                 });
             }
             (Some(_), Some(_)) => self.count += 2,
@@ -115,15 +120,19 @@ where
         impacts: &Impacts<T, N>,
         d: &SVector<T, N>,
         (sigma, sigma_start): (T, T),
-        report: &mut UpdateReport<T, N, K>,
     ) -> Result<Option<SVector<T, N>>, T> {
-        let Impact { s, p, w, i, e } = match impacts.last {
+        let Impact {
+            s,
+            p,
+            w,
+            i,
+            e,
+            row,
+            free,
+        } = match impacts.last {
             Some(last) if impacts.count == 1 && sigma > T::zero() => last,
             _ => return Ok(None),
         };
-        let free = self.free(s, &p, &w, report)?;
-        let (_, jac) = self.contact(&p)?;
-        let row = jac.row(i);
         let approach = row.dot(&w.transpose());
         let normal_accel = row.dot(&free.accel.transpose()) + self.jacobian_rate(&p, &w)?[i];
         if approach >= T::zero() || normal_accel >= T::zero() {

@@ -7,12 +7,14 @@
 //! observers and the filter make the same decisions (classification, root
 //! search, Newton's law, sliding) in the same order, with the same bits.
 
-use nalgebra::{RealField, SVector};
+use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::IndexSet;
 use crate::model::Model;
 
-use super::{Contact, Crossing, Interval, Point, Result, Segment, UpdateReport, check_contact};
+use super::{
+    Contact, Crossing, Free, Interval, Point, Result, Segment, UpdateReport, check_contact,
+};
 
 /// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
 /// length `h`, with the persistent contacts `sliding` held at acceleration
@@ -42,6 +44,10 @@ pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> 
     pub elastic: IndexSet<K>,
     pub guard: IndexSet<K>,
     pub restitution: &'a SVector<T, K>,
+    /// `J(p)`, as the law used it.
+    pub jac: &'a SMatrix<T, K, N>,
+    /// `M(p)` factored and the free acceleration at `(s, p, w⁻)`.
+    pub free: &'a Free<T, N>,
 }
 
 /// What follows the predicted motion of an interval, piece by piece.
@@ -127,6 +133,8 @@ where
                     elastic,
                     guard: touched.intersection(c.approaching),
                     restitution: &self.restitution,
+                    jac: &jac,
+                    free: &free,
                 })?;
                 w = w_plus;
                 resolved = resolved.union(c.approaching);

@@ -243,7 +243,7 @@ where
         }
         // the impact time moves with the constraint whose root timed it
         // (the fastest-approaching if several), for an elastic law only
-        let (_, jac) = self.model.contact(jump.p);
+        let jac = jump.jac;
         let guard = jump
             .guard
             .intersection(jump.elastic)
