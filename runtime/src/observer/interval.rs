@@ -252,18 +252,28 @@ struct Segment<T: RealField + Copy, const N: usize> {
 }
 
 impl<T: RealField + Copy, const N: usize> Segment<T, N> {
+    /// Position at the fraction `x = σ/h ∈ [0, 1]` of the segment (no
+    /// division: the root search works in fractions).
+    fn position(&self, x: T) -> SVector<T, N> {
+        let one = T::one();
+        let two: T = nalgebra::convert(2.0);
+        let three: T = nalgebra::convert(3.0);
+        let (x2, x3) = (x * x, x * x * x);
+        let h00 = two * x3 - three * x2 + one;
+        let h10 = x3 - two * x2 + x;
+        let h01 = -two * x3 + three * x2;
+        let h11 = x3 - x2;
+        self.p0 * h00 + self.w0 * (h10 * self.h) + self.p1 * h01 + self.w1 * (h11 * self.h)
+    }
+
     /// Position and velocity at `σ ∈ [0, h]`.
     fn at(&self, sigma: T) -> (SVector<T, N>, SVector<T, N>) {
         let one = T::one();
         let two: T = nalgebra::convert(2.0);
         let three: T = nalgebra::convert(3.0);
         let x = sigma / self.h;
-        let (x2, x3) = (x * x, x * x * x);
-        let h00 = two * x3 - three * x2 + one;
-        let h10 = x3 - two * x2 + x;
-        let h01 = -two * x3 + three * x2;
-        let h11 = x3 - x2;
-        let p = self.p0 * h00 + self.w0 * (h10 * self.h) + self.p1 * h01 + self.w1 * (h11 * self.h);
+        let x2 = x * x;
+        let p = self.position(x);
         let six: T = nalgebra::convert(6.0);
         let four: T = nalgebra::convert(4.0);
         let d00 = six * x2 - six * x;
@@ -272,6 +282,70 @@ impl<T: RealField + Copy, const N: usize> Segment<T, N> {
         let v = (self.p0 - self.p1) * (d00 / self.h) + self.w0 * d10 + self.w1 * d11;
         (p, v)
     }
+}
+
+/// The root in `(0, 1)` of the cubic Hermite interpolant of a function
+/// with values `f0 > 0 ≥ f1` and slopes `d0`, `d1` at `0` and `1`.
+///
+/// It starts at the root of the quadratic through `f0`, `d0` and `f1`
+/// (the interpolant when the cubic coefficient vanishes: a gap quadratic
+/// in `q` along a flight of constant acceleration, such as Example 1's),
+/// by the form of the quadratic formula that does not cancel, or at the
+/// secant point when that quadratic has no root in the bracket; then
+/// Newton steps on the cubic, kept inside the bracket of its sign
+/// (bisection when a step would leave it), until a step is under `tol`;
+/// none when the cubic coefficient is at the rounding of the data.
+fn hermite_root<T: RealField + Copy>((f0, d0): (T, T), (f1, d1): (T, T), tol: T) -> T {
+    let (zero, one) = (T::zero(), T::one());
+    let two: T = nalgebra::convert(2.0);
+    let three: T = nalgebra::convert(3.0);
+    let half: T = nalgebra::convert(0.5);
+    // p(x) = f0 + d0 x + c2 x² + c3 x³
+    let df = f1 - f0;
+    let c2 = three * df - two * d0 - d1;
+    let c3 = d0 + d1 - two * df;
+    // the quadratic f0 + d0 x + a x², a = f1 − f0 − d0: its root in
+    // (0, 1) is 2 f0 / (−d0 + √(d0² − 4 a f0)) (f0 > 0, so the
+    // discriminant exceeds d0² when a < 0)
+    let a = df - d0;
+    let disc = d0 * d0 - two * two * a * f0;
+    let root = two * f0 / (disc.max(zero).sqrt() - d0);
+    let quadratic = disc >= zero && root > zero && root < one;
+    // a cubic coefficient at the rounding of the data: the quadratic's
+    // root is the interpolant's
+    let rounding = T::default_epsilon() * nalgebra::convert(8.0);
+    if quadratic && c3.abs() <= rounding * (f0.abs() + d0.abs() + f1.abs() + d1.abs()) {
+        return root;
+    }
+    let (mut lo, mut hi) = (zero, one);
+    let mut x = if quadratic { root } else { f0 / (f0 - f1) };
+    for _ in 0..8 {
+        let p = f0 + x * (d0 + x * (c2 + x * c3));
+        if p == zero {
+            break;
+        }
+        if p > zero {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let dp = d0 + x * (two * c2 + x * three * c3);
+        let step = p / dp;
+        let next = x - step;
+        // (a NaN step ends the search too)
+        let converged = step.abs().partial_cmp(&tol) != Some(core::cmp::Ordering::Greater);
+        x = if next > lo && next < hi {
+            next
+        } else if converged {
+            x
+        } else {
+            (lo + hi) * half
+        };
+        if converged {
+            break;
+        }
+    }
+    x
 }
 
 /// How each constraint stands at the start of a piece of motion.
@@ -788,6 +862,22 @@ where
         self.classify(at, (h, jac), resolved, touched)
     }
 
+    /// How close in time the search locates a crossing, and how close two
+    /// crossings must be to count as simultaneous: `max(1024 ε, ε^⅔) τ`.
+    ///
+    /// A gap is known only to its rounding, about `ε` times the size of
+    /// its terms (Example 1's `y − x²` near `x = 2.5`: 1.5e-15 m), so a
+    /// root is known to that over the approach speed; at `1024 ε τ`
+    /// (2.3e-16 s at 1 kHz in `f64`) the search spent its last evaluations
+    /// in that rounding noise. `ε^⅔ τ` (3.7e-14 s at 1 kHz, a position
+    /// 3.7e-13 m off at 10 m/s) lies above it for approach speeds above a
+    /// few mm/s; in `f32` the bound is `1024 ε τ`, as before.
+    fn crossing_tolerance(&self) -> T {
+        let eps = T::default_epsilon();
+        let third = crate::linalg::cbrt_epsilon::<T>();
+        (eps * nalgebra::convert(1024.0)).max(third * third) * self.tau
+    }
+
     /// `h_i` along the segment at `σ`.
     fn gap_at(&self, seg: &Segment<T, N>, i: usize, sigma: T) -> Result<T, T> {
         let (p, _) = seg.at(sigma);
@@ -796,38 +886,117 @@ where
         Ok(h[i])
     }
 
-    /// Root of `h_i` along the segment in `[a, b]`, `f(a) > 0 ≥ f(b)`, by
-    /// the Illinois variant of regula falsi; returns a point with
-    /// `f ≤ 0` within `1024 ε τ` of the root.
-    fn root(&self, seg: &Segment<T, N>, i: usize, bracket: [(T, T); 2]) -> Result<T, T> {
-        let [(mut a, mut fa), (mut b, mut fb)] = bracket;
-        let tol = T::default_epsilon() * nalgebra::convert(1024.0) * self.tau;
+    /// `h_i` along the segment at the fraction `x = σ/h` of it.
+    #[inline(always)]
+    fn gap_at_fraction(&self, seg: &Segment<T, N>, i: usize, x: T) -> Result<T, T> {
+        let h = self.model.gaps(&seg.position(x));
+        finite(&h, "h")?;
+        Ok(h[i])
+    }
+
+    /// Root of `h_i` along the segment between the fractions `a` and `b`
+    /// of it, `f(a) > 0 ≥ f(b)`: returns `σ = x h` at a fraction `x` with
+    /// `f(x) ≤ 0` within the [crossing tolerance](Self::crossing_tolerance)
+    /// (in time) of one where `f > 0`.
+    ///
+    /// Brent's method (inverse quadratic interpolation and secant steps,
+    /// safeguarded by bisection, and a step of at least the tolerance, so
+    /// that an exact estimate closes the bracket with one more evaluation).
+    /// With the slopes `d0`, `d1` of `f` at the two ends (in fractions:
+    /// `h_i`'s rate times `h`), its first point is the root of `f`'s own
+    /// cubic Hermite interpolant ([`hermite_root`]), good to `O(h⁴)` along
+    /// the segment's fourth-order motion and exact for a gap quadratic in
+    /// `q` along a flight of constant acceleration (Example 1's): two
+    /// evaluations of the gaps then locate the impact, where the regula
+    /// falsi from the bracket's ends to `1024 ε τ` took seven.
+    fn root(
+        &self,
+        seg: &Segment<T, N>,
+        i: usize,
+        bracket: [(T, T); 2],
+        slopes: Option<(T, T)>,
+    ) -> Result<T, T> {
+        let zero = T::zero();
         let half: T = nalgebra::convert(0.5);
-        let mut last = 0i8;
-        for _ in 0..128 {
-            if b - a <= tol || fb == T::zero() {
-                break;
-            }
-            let mut c = (a * fb - b * fa) / (fb - fa);
-            if !(c > a && c < b) {
-                c = (a + b) * half;
-            }
-            let fc = self.gap_at(seg, i, c)?;
-            if fc > T::zero() {
-                (a, fa) = (c, fc);
-                if last == -1 {
-                    fb *= half;
-                }
-                last = -1;
-            } else {
-                (b, fb) = (c, fc);
-                if last == 1 {
-                    fa *= half;
-                }
-                last = 1;
+        let two: T = nalgebra::convert(2.0);
+        let three: T = nalgebra::convert(3.0);
+        let eps = T::default_epsilon();
+        // `|c − b| ≤ 4 ε |b| + t ≤ tol` at the end, with `|b| ≤ 1`
+        let tol = self.crossing_tolerance() / seg.h;
+        let t = tol * half;
+        let [(left, f_left), (right, f_right)] = bracket;
+        // `b` the best point, `c` the other side of the root, `a` the
+        // point before `b`
+        let (mut a, mut fa, mut b, mut fb, mut c, mut fc) =
+            (left, f_left, right, f_right, left, f_left);
+        if let Some((d0, d1)) = slopes {
+            let guess = hermite_root((f_left, d0), (f_right, d1), t * half);
+            if guess > left && guess < right {
+                let f_guess = self.gap_at_fraction(seg, i, guess)?;
+                (b, fb) = (guess, f_guess);
+                ((a, fa), (c, fc)) = if f_guess > zero {
+                    ((left, f_left), (right, f_right))
+                } else {
+                    ((right, f_right), (left, f_left))
+                };
             }
         }
-        Ok(b)
+        let (mut d, mut e) = (b - a, b - a);
+        for _ in 0..128 {
+            if fc.abs() < fb.abs() {
+                (a, fa) = (b, fb);
+                (b, fb) = (c, fc);
+                (c, fc) = (a, fa);
+            }
+            let tol1 = two * eps * b.abs() + half * t;
+            let xm = half * (c - b);
+            if xm.abs() <= tol1 || fb == zero {
+                break;
+            }
+            if e.abs() >= tol1 && fa.abs() > fb.abs() {
+                let s = fb / fa;
+                let (mut p, mut q) = if a == c {
+                    // secant
+                    (two * xm * s, T::one() - s)
+                } else {
+                    // inverse quadratic interpolation
+                    let (q, r) = (fa / fc, fb / fc);
+                    (
+                        s * (two * xm * q * (q - r) - (b - a) * (r - T::one())),
+                        (q - T::one()) * (r - T::one()) * (s - T::one()),
+                    )
+                };
+                if p > zero {
+                    q = -q;
+                } else {
+                    p = -p;
+                }
+                let last = e;
+                e = d;
+                if two * p < three * xm * q - (tol1 * q).abs() && p < (half * last * q).abs() {
+                    d = p / q;
+                } else {
+                    (d, e) = (xm, xm);
+                }
+            } else {
+                (d, e) = (xm, xm);
+            }
+            (a, fa) = (b, fb);
+            b += if d.abs() > tol1 {
+                d
+            } else if xm > zero {
+                tol1
+            } else {
+                -tol1
+            };
+            fb = self.gap_at_fraction(seg, i, b)?;
+            if (fb > zero) == (fc > zero) {
+                (c, fc) = (a, fa);
+                (d, e) = (b - a, b - a);
+            }
+        }
+        // the side where the gap is closed
+        Ok(if fb > zero { c } else { b } * seg.h)
     }
 
     /// The extremum of `h_i` along the segment in `[a, b]`, where its rate
@@ -871,9 +1040,9 @@ where
     ) -> Result<Option<Crossing<T, K>>, T> {
         let (h0, rate0) = start;
         let (h1, rate1) = end;
-        let zero = T::zero();
+        let (zero, one) = (T::zero(), T::one());
         let mut best: Option<(T, IndexSet<K>)> = None;
-        let tol = T::default_epsilon() * nalgebra::convert(1024.0) * self.tau;
+        let tol = self.crossing_tolerance();
         let mut record = |at: T, i: usize| match &mut best {
             Some((s, set)) if (at - *s).abs() <= tol => {
                 set.insert(i);
@@ -887,11 +1056,18 @@ where
         };
         for i in c.free {
             if h1[i] <= zero {
-                record(self.root(seg, i, [(zero, h0[i]), (seg.h, h1[i])])?, i);
+                let slopes = (rate0[i] * seg.h, rate1[i] * seg.h);
+                record(
+                    self.root(seg, i, [(zero, h0[i]), (one, h1[i])], Some(slopes))?,
+                    i,
+                );
             } else if rate0[i] < zero && rate1[i] > zero {
                 let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
                 if fm <= zero {
-                    record(self.root(seg, i, [(zero, h0[i]), (m, fm)])?, i);
+                    record(
+                        self.root(seg, i, [(zero, h0[i]), (m / seg.h, fm)], None)?,
+                        i,
+                    );
                 }
             }
         }
@@ -903,7 +1079,7 @@ where
                 // contact
                 let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
                 if fm > jac.row(i).norm() * band {
-                    record(self.root(seg, i, [(m, fm), (seg.h, h1[i])])?, i);
+                    record(self.root(seg, i, [(m / seg.h, fm), (one, h1[i])], None)?, i);
                 } else {
                     record(m, i);
                 }
@@ -969,5 +1145,40 @@ where
             chol: &free.chol,
         };
         self.newton(&at, c.contact, c.elastic, report)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hermite_root;
+
+    /// The interpolant of a quadratic is the quadratic: its root comes
+    /// from the formula, to rounding.
+    #[test]
+    fn hermite_root_of_a_quadratic_is_its_root() {
+        // f = 0.3 − 0.1 x − 0.9 x², root (−0.1 + √(0.01 + 1.08)) / 1.8
+        let f = |x: f64| 0.3 - 0.1 * x - 0.9 * x * x;
+        let df = |x: f64| -0.1 - 1.8 * x;
+        let root = hermite_root((f(0.0), df(0.0)), (f(1.0), df(1.0)), 1e-16);
+        let exact = (-0.1 + (0.01_f64 + 1.08).sqrt()) / 1.8;
+        assert!((root - exact).abs() <= 4.0 * f64::EPSILON, "{root} {exact}");
+    }
+
+    /// A true cubic: Newton from the quadratic's root, to its tolerance;
+    /// an iterate that lands on the root exactly (`p = 0`) is kept, not
+    /// bisected away (that bug put the billiard's first guess at half its
+    /// root).
+    #[test]
+    fn hermite_root_of_a_cubic_converges_and_keeps_an_exact_root() {
+        // p = (0.5 − x)(1 + x²): p(0.5) = 0 exactly
+        let p = |x: f64| (0.5 - x) * (1.0 + x * x);
+        let dp = |x: f64| -(1.0 + x * x) + (0.5 - x) * 2.0 * x;
+        let root = hermite_root((p(0.0), dp(0.0)), (p(1.0), dp(1.0)), 1e-15);
+        assert!((root - 0.5).abs() <= 1e-15, "{root}");
+        // another cubic, in f32
+        let q = |x: f32| 0.2 - x + 0.3 * x * x * x;
+        let dq = |x: f32| -1.0 + 0.9 * x * x;
+        let root = hermite_root((q(0.0), dq(0.0)), (q(1.0), dq(1.0)), 1e-7);
+        assert!(q(root).abs() <= 4.0 * f32::EPSILON, "{root} {}", q(root));
     }
 }

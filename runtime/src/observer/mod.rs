@@ -109,8 +109,9 @@
 //!    injection turns into a lag of `τ² |d³q/dt³|/6`: 8e-5 m/s where
 //!    Example 1 slides through the bottom of its parabola). Along each
 //!    piece, the cubic Hermite interpolant of `(p, w)` at its ends locates
-//!    the first constraint to close (Illinois regula falsi on `h_i(p(s))`,
-//!    to `1024 ε τ`); the piece is integrated again up to that root `s*`,
+//!    the first constraint to close (Brent's method on `h_i(p(s))`, from
+//!    the root of the cubic Hermite interpolant of `h_i` itself, to
+//!    `max(1024 ε, ε^⅔) τ`); the piece is integrated again up to that root `s*`,
 //!    Newton's law is applied at `q* = p(s*)`, and the prediction goes on
 //!    from `(q*, v̂⁺)`: several impacts per interval, and accumulations,
 //!    follow (up to [`ObserverParams::max_impacts`]). Persistent contacts
