@@ -878,14 +878,6 @@ where
         (eps * nalgebra::convert(1024.0)).max(third * third) * self.tau
     }
 
-    /// `h_i` along the segment at `σ`.
-    fn gap_at(&self, seg: &Segment<T, N>, i: usize, sigma: T) -> Result<T, T> {
-        let (p, _) = seg.at(sigma);
-        let h = self.model.gaps(&p);
-        finite(&h, "h")?;
-        Ok(h[i])
-    }
-
     /// `h_i` along the segment at the fraction `x = σ/h` of it.
     #[inline(always)]
     fn gap_at_fraction(&self, seg: &Segment<T, N>, i: usize, x: T) -> Result<T, T> {
@@ -1023,7 +1015,7 @@ where
             }
         }
         let m = (a + b) * half;
-        Ok((m, self.gap_at(seg, i, m)?))
+        Ok((m, self.gap_at_fraction(seg, i, m / seg.h)?))
     }
 
     /// The first constraint to close along the segment (see the module
