@@ -88,6 +88,21 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
         }
     }
 
+    /// The product `self · (a, b)` with the stacked vector `(a, b)`, as its
+    /// position and velocity parts.
+    ///
+    /// ```
+    /// use moreau_runtime::Blocks;
+    /// use nalgebra::Vector1;
+    ///
+    /// let phi = Blocks { qq: Vector1::new(1.0), qv: Vector1::new(0.5), vq: Vector1::new(0.0), vv: Vector1::new(1.0) };
+    /// assert_eq!(phi.apply(&Vector1::new(1.0), &Vector1::new(2.0)), (Vector1::new(2.0), Vector1::new(2.0)));
+    /// ```
+    #[must_use]
+    pub fn apply(&self, a: &SVector<T, N>, b: &SVector<T, N>) -> (SVector<T, N>, SVector<T, N>) {
+        (self.qq * a + self.qv * b, self.vq * a + self.vv * b)
+    }
+
     /// The transpose.
     #[must_use]
     pub fn transpose(&self) -> Self {

@@ -149,6 +149,19 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// `τ/√12`; a compliant contact that lasts `t_c` wants about
     /// `t_c/√12`).
     pub impact_time_sigma: T,
+    /// The mean `δ̄` of an impact's instant past the located one, in
+    /// seconds (signed): where impacts come late (or early) on average,
+    /// the predicted state after each moves by `δ̄ d`, with `d` the
+    /// state's shift per unit of delay as for
+    /// [`KalmanParams::impact_time_sigma`], carried to the end of the
+    /// interval by the motion's own Jacobians (module `propagate`).
+    /// Default `0`, a rigid machine. A compliant contact that lasts `t_c`
+    /// rebounds about `t_c/2` after its first touch; a time-stepping plant
+    /// that takes the impact into the step in which it happens (Moreau–Jean
+    /// with a γ-prediction, as [`MoreauJean`](crate::MoreauJean)) resolves it on average half a
+    /// step late. [`tune_process_noise`] picks it from a recorded run,
+    /// with `σ_t`.
+    pub impact_delay: T,
     /// Relative accuracy `ρ_c` of a persistent contact's force, as a
     /// density (units √s): along a piece of sliding or resting contact
     /// with contact acceleration `a_c = M⁻¹Jᵀλ`, white acceleration noise
@@ -235,6 +248,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             initial_velocity_sigma: velocity_bound,
             impact_noise: nalgebra::convert(1e-5),
             impact_time_sigma: nalgebra::convert(3e-6),
+            impact_delay: T::zero(),
             contact_noise: nalgebra::convert(1e-6),
         }
     }
@@ -262,21 +276,20 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     pub fn scaled(self, factor: T) -> Self {
         self.scaled_by(&NoiseFactors {
             accel: factor,
-            impact: T::one(),
-            impact_time: T::one(),
-            contact: T::one(),
+            ..NoiseFactors::unit()
         })
     }
 
     /// The same settings with each process-noise knob scaled by its
-    /// factor (what [`tune_process_noise`] returns).
+    /// factor, and the mean impact delay shifted (what
+    /// [`tune_process_noise`] returns).
     ///
     /// ```
     /// use moreau_runtime::{KalmanParams, NoiseFactors};
     ///
-    /// let f = NoiseFactors { accel: 2.0, impact: 1.0, impact_time: 0.5, contact: 1.0 };
+    /// let f = NoiseFactors { accel: 2.0, impact_time: 0.5, delay: 4e-6, ..NoiseFactors::unit() };
     /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).scaled_by(&f);
-    /// assert_eq!((p.accel_noise[0], p.impact_time_sigma), (2e-5, 1.5e-6));
+    /// assert_eq!((p.accel_noise[0], p.impact_time_sigma, p.impact_delay), (2e-5, 1.5e-6, 4e-6));
     /// ```
     #[must_use]
     pub fn scaled_by(self, f: &NoiseFactors<T>) -> Self {
@@ -285,6 +298,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             impact_noise: self.impact_noise * f.impact,
             impact_time_sigma: self.impact_time_sigma * f.impact_time,
             contact_noise: self.contact_noise * f.contact,
+            impact_delay: self.impact_delay + f.delay,
             ..self
         }
     }
@@ -330,6 +344,9 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             if !(s >= T::zero() && s.is_finite()) {
                 return bad(name, s);
             }
+        }
+        if !self.impact_delay.is_finite() {
+            return bad("impact_delay", self.impact_delay);
         }
         Ok(())
     }
@@ -680,8 +697,8 @@ where
             }
         };
         let (q_pred, v_pred) = (
-            q_pred + propagation.correction.0,
-            v_pred + propagation.correction.1,
+            q_pred + propagation.correction.0 + propagation.offset.0,
+            v_pred + propagation.correction.1 + propagation.offset.1,
         );
         let mut p = propagation.p;
         let mut kalman = KalmanReport {

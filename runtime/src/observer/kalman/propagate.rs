@@ -17,7 +17,10 @@
 //!   impact lasts): `P_vv += ρ_i² (ΔvᵀMΔv / N) M⁻¹` (isotropic in the
 //!   metric of the kinetic energy: the error's expected energy is `ρ_i²`
 //!   times the jump's) and `P += σ_t² d dᵀ`, `d` the post-impact state's
-//!   shift per unit of delay ([`Saltation::timing`]);
+//!   shift per unit of delay ([`Saltation::timing`]); where the impacts
+//!   come late (or early) on average, by `δ̄`
+//!   ([`KalmanParams::impact_delay`]), the predicted state moves by
+//!   `δ̄ d` as well (below);
 //! - **along a persistent contact**, the contact force `M⁻¹Jᵀλ = a_c` is
 //!   known only to a relative density `ρ_c` ([`KalmanParams::contact_noise`];
 //!   friction, compliance, a discretised plant's drift along a curved
@@ -29,6 +32,18 @@
 //! tuned on one run carries over to runs with harder or softer impacts;
 //! [`tune_process_noise`](super::tune_process_noise) picks all four knobs
 //! from a recorded run.
+//!
+//! # The mean delay of an impact
+//!
+//! A shift `δ̄ d` of the state just after an impact is a perturbation of
+//! the predicted motion, and the motion carries it to the end of the
+//! interval as it carries the covariance: through each piece's transition
+//! matrix `Φ`, each later impact's saltation matrix `Ξ` and each
+//! projection `B` onto a contact manifold. [`Propagation::offset`] is that
+//! sum, first order in `δ̄`, added to the predicted end of the interval
+//! (the state itself is never moved in the middle of the interval: a
+//! post-impact state moved along `d` lies a little inside the constraint,
+//! which the interval's event location would take for a crossing).
 
 use nalgebra::{RealField, SMatrix, SVector};
 
@@ -68,6 +83,11 @@ where
     /// The move of the predicted end onto the contact manifold, when the
     /// last piece was a persistent contact.
     pub correction: (SVector<T, N>, SVector<T, N>),
+    /// `δ̄`, the mean delay of an impact.
+    delay: T,
+    /// The predicted end's shift from the mean delays of the impacts so
+    /// far, carried to the end of the last piece (module docs).
+    pub offset: (SVector<T, N>, SVector<T, N>),
     pub saltations: u32,
     pub projections: u32,
 }
@@ -97,6 +117,8 @@ where
             timing: square(params.impact_time_sigma),
             p,
             correction: (SVector::zeros(), SVector::zeros()),
+            delay: params.impact_delay,
+            offset: (SVector::zeros(), SVector::zeros()),
             saltations: 0,
             projections: 0,
         }
@@ -195,7 +217,9 @@ where
             constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
         };
         let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
-        let mut p = transition(&a, piece.h).congruence(&self.p).add(&noise);
+        let phi = transition(&a, piece.h);
+        let mut p = phi.congruence(&self.p).add(&noise);
+        self.offset = phi.apply(&self.offset.0, &self.offset.1);
         self.correction = (SVector::zeros(), SVector::zeros());
         if !held.is_empty() {
             // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
@@ -210,11 +234,12 @@ where
             let mass = factor_mass(&m)?;
             let contact = self.contact_density(piece, held, &jac, (&m, &mass));
             p = p.add(&white_noise(&contact, piece.h));
-            if let Some((projected, dq, dv)) =
+            if let Some(projection) =
                 project_onto_contact(&p, &mass, &h, &jac, &rate, piece.w1, held)
             {
-                p = projected;
-                self.correction = (dq, dv);
+                p = projection.p;
+                self.correction = (projection.dq, projection.dv);
+                self.offset = projection.map.apply(&self.offset.0, &self.offset.1);
                 self.projections += 1;
             }
             // what the contact leaves uncertain across it: the noise's
@@ -273,6 +298,15 @@ where
         )?;
         let noise = self.impact_noise(&s, jump.p, &w)?;
         self.p = s.matrix.congruence(&self.p).add(&noise).symmetrized();
+        let (dq, dv) = s.matrix.apply(&self.offset.0, &self.offset.1);
+        // the mean delay, for an impact that a gap's root timed (a closure
+        // the LCP makes at the start of a piece has no instant to delay)
+        let delay = if guard.is_some() {
+            self.delay
+        } else {
+            T::zero()
+        };
+        self.offset = (dq + s.timing.0 * delay, dv + s.timing.1 * delay);
         self.saltations += 1;
         Ok(())
     }

@@ -461,6 +461,17 @@ where
     })
 }
 
+/// What [`project_onto_contact`] returns.
+pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
+    /// `B P Bᵀ`.
+    pub p: Blocks<T, N>,
+    /// The projector `B` itself.
+    pub map: Blocks<T, N>,
+    /// The state's move onto the manifold, position and velocity.
+    pub dq: SVector<T, N>,
+    pub dv: SVector<T, N>,
+}
+
 /// Projects the state's perturbations onto the tangent space of the
 /// contact manifold `h_S(q) = 0`, `J_S(q) v = 0` at `(q, v)`, in the metric
 /// of the mass matrix (the metric of Newton's law: a plastic impact
@@ -473,9 +484,9 @@ where
 /// `D δq + J_S δv = 0`; `P ← B P Bᵀ` (a congruence: positive
 /// semi-definite whatever the round-off of `P`). The state moves onto the
 /// manifold along the same metric: `δq = −J⁺ h_S`, then
-/// `δv = −J⁺ (J_S v + D δq)`. Returns `(B P Bᵀ, δq, δv)`, or `None` when
-/// the rows of `set` are dependent.
-#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+/// `δv = −J⁺ (J_S v + D δq)`. Returns `None` when the rows of `set` are
+/// dependent.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K: usize>(
     p: &Blocks<T, N>,
     mass: &Cholesky<T, N>,
@@ -484,7 +495,7 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
     rate: &SMatrix<T, K, N>,
     v: &SVector<T, N>,
     set: IndexSet<K>,
-) -> Option<(Blocks<T, N>, SVector<T, N>, SVector<T, N>)> {
+) -> Option<Projection<T, N>> {
     let mut j = SMatrix::<T, K, N>::zeros();
     let mut d = SMatrix::<T, K, N>::zeros();
     let mut w = SMatrix::<T, K, K>::identity();
@@ -514,5 +525,10 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
     };
     let dq = -(pinv * r_h);
     let dv = -(pinv * (j * v + d * dq));
-    Some((b.congruence(p), dq, dv))
+    Some(Projection {
+        p: b.congruence(p),
+        map: b,
+        dq,
+        dv,
+    })
 }

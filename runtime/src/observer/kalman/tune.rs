@@ -20,16 +20,41 @@ pub struct NoiseFactors<T> {
     pub impact_time: T,
     /// On [`KalmanParams::contact_noise`].
     pub contact: T,
+    /// Added to [`KalmanParams::impact_delay`], in seconds: the one knob
+    /// that is shifted rather than scaled, since a mean delay has either
+    /// sign and its natural start is zero.
+    pub delay: T,
 }
 
 impl<T: RealField + Copy> NoiseFactors<T> {
-    /// `ten^x` for each exponent, in the order of the fields.
-    fn from_exponents(x: &[T; KNOBS], ten: T) -> Self {
+    /// No change: every factor one, no delay added.
+    ///
+    /// ```
+    /// use moreau_runtime::{KalmanParams, NoiseFactors};
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4);
+    /// assert_eq!(p.scaled_by(&NoiseFactors::unit()), p);
+    /// ```
+    #[must_use]
+    pub fn unit() -> Self {
+        Self {
+            accel: T::one(),
+            impact: T::one(),
+            impact_time: T::one(),
+            contact: T::one(),
+            delay: T::zero(),
+        }
+    }
+
+    /// `ten^x` for each of the four scaled knobs, in the order of the
+    /// fields; the delay `x[4] σ_t` (`σ_t` the given impact-time spread).
+    fn from_coordinates(x: &[T; KNOBS], ten: T, sigma_t: T) -> Self {
         Self {
             accel: ten.powf(x[0]),
             impact: ten.powf(x[1]),
             impact_time: ten.powf(x[2]),
             contact: ten.powf(x[3]),
+            delay: x[DELAY] * sigma_t,
         }
     }
 }
@@ -48,12 +73,15 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
     pub evaluations: u32,
 }
 
-/// Picks the four process-noise knobs of `params` (acceleration, impact,
-/// impact-time and contact noise) for a recorded run by maximising the
-/// innovation log-likelihood, each knob scaled by a factor `10^x`, `x ∈
-/// [lo, hi]`: coordinate ascent in the exponents, a first sweep with a
-/// grid of seven points per knob and golden-section search around the
-/// best, a second with golden-section search around the first's point.
+/// Picks the process-noise knobs of `params` (acceleration, impact,
+/// impact-time and contact noise, and the impacts' mean delay) for a
+/// recorded run by maximising the innovation log-likelihood: each of the
+/// four noise knobs scaled by a factor `10^x`, `x ∈ [lo, hi]`, and the
+/// delay shifted by `y σ_t`, `y ∈ [−3, 3]` (`σ_t` the given
+/// [`KalmanParams::impact_time_sigma`]; with `σ_t = 0` the delay stays
+/// where it is). Coordinate ascent: a first sweep with a grid of seven
+/// points per knob and golden-section search around the best, a second
+/// with golden-section search around the first's point.
 /// Each evaluation runs a filter over the record from `(t[0], q[0])` with
 /// the velocity estimate `v0`; nothing allocates.
 ///
@@ -67,8 +95,9 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
 /// the flat region, and a knob picked there does worse on other runs than
 /// the knob it started from. So each exponent carries a weak prior,
 /// normal with a standard deviation of one decade around the given knob
-/// (`x = 0`): the search maximises the log-likelihood minus `x²/2` per
-/// knob (maximum a posteriori). A record that asks for a knob a decade
+/// (`x = 0`), and the delay one with a standard deviation of `σ_t` around
+/// the given delay (`y = 0`): the search maximises the log-likelihood
+/// minus `x²/2` per knob (maximum a posteriori). A record that asks for a knob a decade
 /// away pays half a nat for it, while the likelihood of a record that
 /// needs the change moves by tens to thousands of nats: such a record
 /// still moves the knob freely; a flat one leaves it where it was.
@@ -119,7 +148,7 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
 /// let tuned = tune_process_noise::<_, _, 1, 0>(&Free, params, &t, &q, &Vector1::zeros(), &SVector::zeros(), (-2.0, 4.0))?;
 /// assert!(tuned.factors.accel > 2.0, "{:?}", tuned.factors);
 /// // no contact in the record: the contact knobs keep their values
-/// assert_eq!((tuned.factors.impact, tuned.factors.contact), (1.0, 1.0));
+/// assert_eq!((tuned.factors.impact, tuned.factors.contact, tuned.factors.delay), (1.0, 1.0, 0.0));
 /// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
 /// ```
 ///
@@ -151,13 +180,14 @@ where
     let ten: T = nalgebra::convert(10.0);
     let mut evaluations = 0u32;
     // the prior: normal in each exponent, one decade around the given knob
+    let sigma_t = params.impact_time_sigma;
     let prior = |x: &[T; KNOBS]| -> T {
         let half: T = nalgebra::convert(0.5);
         x.iter().fold(T::zero(), |acc, &xk| acc - half * xk * xk)
     };
     let mut posterior = |x: &[T; KNOBS]| -> Result<T, ObserverError<T>> {
         evaluations += 1;
-        let p = params.scaled_by(&NoiseFactors::from_exponents(x, ten));
+        let p = params.scaled_by(&NoiseFactors::from_coordinates(x, ten, sigma_t));
         let mut filter = SaltationKalman::<T, N, K>::new(p, t[0], q[0], *v0)?;
         let mut total = T::zero();
         for (&tk, qk) in t.iter().zip(q).skip(1) {
@@ -178,11 +208,20 @@ where
     // first sweep a grid over [lo, hi] and golden-section search around
     // its best point, the second golden-section search around the first
     // sweep's point
-    let step = (hi - lo) / nalgebra::convert((GRID - 1) as f64);
+    let three: T = nalgebra::convert(3.0);
     let mut x = [T::zero(); KNOBS];
     let mut best = posterior(&x)?;
     for sweep in 0..2 {
         for knob in 0..KNOBS {
+            let (lo, hi) = if knob == DELAY {
+                if sigma_t == T::zero() {
+                    continue;
+                }
+                (-three, three)
+            } else {
+                (lo, hi)
+            };
+            let step = (hi - lo) / nalgebra::convert((GRID - 1) as f64);
             let mut centre = x[knob];
             if sweep == 0 {
                 for j in 0..GRID {
@@ -204,7 +243,7 @@ where
             best = best.max(l);
         }
     }
-    let factors = NoiseFactors::from_exponents(&x, ten);
+    let factors = NoiseFactors::from_coordinates(&x, ten, sigma_t);
     Ok(Tuning {
         params: params.scaled_by(&factors),
         factors,
@@ -215,8 +254,11 @@ where
 
 /// Points of the first sweep's grid per knob.
 const GRID: usize = 7;
-/// The knobs: acceleration, impact, impact-time and contact noise.
-const KNOBS: usize = 4;
+/// The knobs: acceleration, impact, impact-time and contact noise (as
+/// exponents), and the mean delay (in units of `σ_t`).
+const KNOBS: usize = 5;
+/// The coordinate of the mean delay.
+const DELAY: usize = 4;
 
 /// The maximum of `f` over `[a, b]` by golden-section search (14 steps),
 /// with its value.
