@@ -197,8 +197,12 @@ where
     let knobs = tuned.params;
     println!();
     println!(
-        "{title}: median |v − v̂| over t ∈ [2, {T_END}] s, 1 kHz (filter: q_a = {:.2e}, ρ_i = {:.2e}, σ_t = {:.2e}, ρ_c = {:.2e} from 3 s of one σ = 1e-4 run)",
-        knobs.accel_noise[0], knobs.impact_noise, knobs.impact_time_sigma, knobs.contact_noise
+        "{title}: median |v − v̂| over t ∈ [2, {T_END}] s, 1 kHz (filter: q_a = {:.2e}, ρ_i = {:.2e}, σ_t = {:.2e}, δ̄ = {:.2e}, ρ_c = {:.2e} from 3 s of one σ = 1e-4 run)",
+        knobs.accel_noise[0],
+        knobs.impact_noise,
+        knobs.impact_time_sigma,
+        knobs.impact_delay,
+        knobs.contact_noise
     );
     print!("  {:>8}", "σ");
     for name in ESTIMATORS {
