@@ -467,8 +467,9 @@ pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
     pub p: Blocks<T, N>,
     /// The projector `B` itself.
     pub map: Blocks<T, N>,
-    /// The state's move onto the manifold, position and velocity.
+    /// The state's move onto the manifold, position part.
     pub dq: SVector<T, N>,
+    /// The state's move onto the manifold, velocity part.
     pub dv: SVector<T, N>,
 }
 
