@@ -838,13 +838,15 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
 /// percentile at most 4e-4 (the hand-written Python saltation filter the
 /// issue measured on such data: median 5e-5 to 1e-4, 90th percentile 2e-4
 /// to 7e-4), with the defaults the median below that filter's best
-/// (5e-5), and the median at least ten times below that of the
-/// reduced-order observer (38), told `σ`, on the same samples. The
-/// issue's own targets (median ≤ 3e-5, 90th percentile ≤ 2e-4, maximum
-/// ≤ 1e-2 off the bracketing samples) are printed, not asserted: they are
-/// met on some starts only (the plant places each impact somewhere in its
-/// 10 µs step, and micro-bounces in an accumulation rise below σ; see the
-/// README).
+/// (5e-5) and the maximum off the samples that bracket a plant impact
+/// at most the issue's 1e-2 (with a one-deviation contact band the filter
+/// follows the last bounces of an accumulation instead of sliding early,
+/// `KalmanParams::band_sigmas`), and the median at least ten times below
+/// that of the reduced-order observer (38), told `σ`, on the same
+/// samples. The issue's median and 90th-percentile targets (3e-5, 2e-4)
+/// are printed, not asserted: with the defaults they are met on three
+/// starts of four (the plant places each impact somewhere in its 10 µs
+/// step; see the README).
 #[test]
 fn example_1_figures_beside_the_reduced_order_observer() {
     let model = Parabola::<f64>::new();
@@ -915,6 +917,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 assert!(sc.all.median * 10.0 <= so.all.median, "start {n}, {label}");
                 if label == "defaults" {
                     assert!(sc.all.median <= 5e-5, "start {n}: {:e}", sc.all.median);
+                    assert!(sc.clean.max <= 1e-2, "start {n}: {:e}", sc.clean.max);
                 }
             }
         }

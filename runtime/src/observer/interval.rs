@@ -402,6 +402,11 @@ where
     /// the first update). A closed constraint approaching slower than that
     /// cannot be told from a resting one.
     pub uncertainty: T,
+    /// The velocity noise `ν` of the contact rule: for the observers
+    /// `n_σ √2 σ (1 − e^{−l_d τ})/τ`, the injection passing the noise of
+    /// two samples with the gain of one interval (set by
+    /// [`begin`](Self::begin)); the filter sets it from its covariance.
+    pub noise_speed: T,
     /// The factor of `M` when the model's `M` is constant (the same at
     /// every point of the interval): one factorization, or none, per update.
     pub mass: Option<Cholesky<T, N>>,
@@ -478,6 +483,10 @@ where
             q1: *q,
             restitution,
             uncertainty: memory.report.uncertainty(),
+            noise_speed: memory.params.noise_sigmas
+                * memory.params.noise
+                * nalgebra::convert::<f64, T>(core::f64::consts::SQRT_2)
+                * gain,
             gain,
             mass,
             constant,
@@ -732,23 +741,13 @@ where
         })
     }
 
-    /// The velocity scale of measurement noise in the estimate,
-    /// `n_σ √2 σ (1 − e^{−l_d τ})/τ`: the injection passes the noise of two
-    /// samples with the gain of one interval.
-    fn noise_speed(&self) -> T {
-        let p = self.params;
-        p.noise_sigmas
-            * p.noise
-            * nalgebra::convert::<f64, T>(core::f64::consts::SQRT_2)
-            * self.gain
-    }
-
     /// Sorts the constraints at a point `(p, w)` of the predicted motion
     /// (the contact rule of the module docs).
     ///
     /// With `g_i = |∇h_i|`, the band `b_i = g_i (d + n_σ σ)`, the normal
     /// acceleration of the free motion relative to the constraint
-    /// `A_i = |J_i a + J̇_i w|` and the velocity noise `ν = n_σ √2 σ φ_l`,
+    /// `A_i = |J_i a + J̇_i w|` and the velocity noise `ν`
+    /// ([`noise_speed`](Self::noise_speed); `n_σ √2 σ φ_l` for the observers),
     /// the resting speed is
     ///
     /// `v_rest,i = ρ τ A_i + √(4 A_i b_i) + g_i ν + 64 ε g_i |w|`:
@@ -773,7 +772,7 @@ where
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
         let band = self.params.contact_band();
         let mut c = Classes::default();
-        let noise_speed = self.noise_speed();
+        let noise_speed = self.noise_speed;
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
         let four: T = nalgebra::convert(4.0);
         let mut closed = IndexSet::<K>::EMPTY;

@@ -45,7 +45,9 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     /// `SectionVii`, `q_{k+1} − q_k − τ v̂_k`).
     pub innovation: SVector<T, N>,
     /// The injection gain `(1 − e^{−l_d τ}) / τ` the update used (the
-    /// velocity correction is this times the innovation).
+    /// velocity correction is this times the innovation; `0` for the
+    /// [`SaltationKalman`](crate::SaltationKalman) filter, which corrects
+    /// with its Kalman gain instead).
     pub gain: T,
     /// Points at which the model's dynamics `(M, F̄)` were needed (for a
     /// model with constant `M` and `F`, the memo of one evaluation serves

@@ -19,11 +19,13 @@
 //!    model, every impact located inside the interval (Newton's law with
 //!    the LCP on the closed constraints), persistent contacts held at
 //!    acceleration level, under the same contact rule (module docs of
-//!    `runtime/src/observer/mod.rs`), whose noise band is the estimate's
-//!    own position uncertainty `√max P_qq,ii` (at most `σ`) and whose
-//!    velocity noise is `√max P_vv,ii`: the prediction starts from the
-//!    filtered `q̂_k`, not from a raw sample, so a bounce a few `σ` high
-//!    is told from sliding. The interval tells each piece of
+//!    `runtime/src/observer/mod.rs`) with its noise taken from the
+//!    covariance: the band is [`KalmanParams::band_sigmas`] (default 1)
+//!    times the estimate's own position uncertainty `σ_q = √max P_qq,ii`
+//!    (at most `σ`), the velocity tests `n_σ` times `σ_v = √max P_vv,ii`.
+//!    The prediction starts from the filtered `q̂_k`, not from a raw
+//!    sample, so a bounce a few `σ_q` high (`σ_q` a small fraction of `σ`
+//!    after a few samples) is told from sliding. The interval tells each piece of
 //!    motion and each impact as it happens, and the covariance follows:
 //!    - a piece of flight of length `h` from `x_0`:
 //!      `P ← Φ P Φᵀ + Q(h)`, `Φ` the [`transition`] of the Jacobian
@@ -169,6 +171,23 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// discretised plant's drift along a curved surface are what the
     /// frictionless rigid contact leaves out). Default `1e-6`.
     pub contact_noise: T,
+    /// The contact rule's distance band, in standard deviations of the
+    /// estimate's position (default `1`): a constraint is closed where the
+    /// predicted gap is within `d + b_σ σ_q` (`σ_q = √max P_qq,ii`, at most
+    /// `σ`; `d` the observers' `contact_distance`), and a bounce is told
+    /// from sliding when it rises higher than about twice that band (the
+    /// resting speed's fall term `√(4 A g b)`). The observers need
+    /// `n_σ = 3` sample deviations there: they carry no covariance, and a
+    /// sample that noise puts outside the band would fall back as an
+    /// impact. The filter predicts from its own estimate, whose error is
+    /// `σ_q`, and a wrong call costs it what its covariance already allows
+    /// for; with three deviations it held the last bounces of an
+    /// accumulation (rebounds of a few cm/s, under `σ` high) as sliding,
+    /// 1e-2 m/s off between them. Its velocity tests keep `n_σ`
+    /// (`observer.noise_sigmas`) deviations of the velocity, `√max P_vv,ii`:
+    /// a pair that travels together must not bounce on its estimate's
+    /// noise (module docs).
+    pub band_sigmas: T,
 }
 
 /// The Cholesky factor of the innovation covariance `S = P_qq + R + δ I`
@@ -250,6 +269,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             impact_time_sigma: nalgebra::convert(3e-6),
             impact_delay: T::zero(),
             contact_noise: nalgebra::convert(1e-6),
+            band_sigmas: T::one(),
         }
     }
 
@@ -340,6 +360,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             ("impact_noise", self.impact_noise),
             ("impact_time_sigma", self.impact_time_sigma),
             ("contact_noise", self.contact_noise),
+            ("band_sigmas", self.band_sigmas),
         ] {
             if !(s >= T::zero() && s.is_finite()) {
                 return bad(name, s);
@@ -642,11 +663,15 @@ where
         u: &M::Input,
     ) -> Result<Estimate<T, N>, T> {
         // the contact rule's band and velocity noise are those of the
-        // estimate the prediction starts from, not of a raw sample
+        // estimate the prediction starts from, not of a raw sample: the
+        // band `d + b_σ σ_q`, the velocity tests `n_σ σ_v`
         let sigma_q = self.p.qq.diagonal().amax().max(T::zero()).sqrt();
         let sigma_v = self.p.vv.diagonal().amax().max(T::zero()).sqrt();
+        let measured_sigma = sigma_q.min(self.params.observer.noise);
+        let band = self.params.band_sigmas * measured_sigma;
         let rule = ObserverParams {
-            noise: sigma_q.min(self.params.observer.noise),
+            noise: T::zero(),
+            contact_distance: self.params.observer.contact_distance + band,
             ..self.params.observer
         };
         let memory = Memory {
@@ -667,14 +692,15 @@ where
         let plan = self
             .screen
             .screen(&self.params.observer, (t, interval.tau), &self.q, q)?;
-        let sigma = rule.noise;
-        interval.gain = if sigma > T::zero() {
-            sigma_v / (sigma * nalgebra::convert(core::f64::consts::SQRT_2))
+        // (with exact samples, `σ = 0`, no noise term, as for the observers)
+        interval.noise_speed = if measured_sigma > T::zero() {
+            rule.noise_sigmas * sigma_v
         } else {
             T::zero()
         };
         interval.uncertainty = rule.noise_sigmas * sigma_v;
-        report.gain = interval.gain;
+        // no injection: the filter's correction is its Kalman gain
+        report.gain = T::zero();
         // PREDICT, the covariance following every piece and impact
         let mut propagation = Propagation::new(model, u, self.t, &self.params, self.p);
         let v0 = saturate(&self.v, self.params.observer.velocity_bound);
