@@ -38,12 +38,12 @@ const REPEATS: usize = 5;
 fn main() -> Result<()> {
     let model = Parabola::<f64>::new();
     let u = SVector::zeros();
+    std::fs::create_dir_all(out_dir()?.join("vs_hybrid_tools"))?;
     let tuned = tuned_process_noise(&model)?;
     let knobs = [
         ("defaults", KalmanParams::new(20.0, SIGMA)),
         ("tuned", tuned),
     ];
-    std::fs::create_dir_all(out_dir()?.join("vs_hybrid_tools"))?;
     println!("Example 1, σ = {SIGMA:e}, |v − v̂| over t ∈ [2, 10] s");
     let mut written = Vec::new();
     for (k, start) in example_1_starts().into_iter().enumerate() {
