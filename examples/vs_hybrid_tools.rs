@@ -26,7 +26,7 @@ use std::time::Instant;
 use moreau::{Estimate, KalmanParams, Observer, SaltationKalman, tune_process_noise};
 use moreau_models::Parabola;
 use nalgebra::{SVector, Vector2};
-use runs::{Reference, example_1_run, example_1_starts, measure, reference, score};
+use runs::{Reference, brackets, example_1_run, example_1_starts, measure, reference, score};
 use support::plot::{Result, announce, csv, out_dir};
 
 /// The measurement noise, as in the test.
@@ -157,21 +157,4 @@ fn tuned_process_noise(model: &Parabola<f64>) -> Result<KalmanParams<f64, 2>> {
         tuned.evaluations
     );
     Ok(p)
-}
-
-/// The samples that bracket a plant impact, as `runs::score` marks them:
-/// the first at or after each impact and the one before it.
-fn brackets(data: &Reference<2>) -> Vec<bool> {
-    let mut bracket = vec![false; data.samples.len()];
-    for &(t, _, _) in &data.impacts {
-        if let Some(first) = data.samples.iter().position(|s| s.t >= t - 1e-12) {
-            bracket[first] = true;
-            if first > 0 {
-                bracket[first - 1] = true;
-            }
-        } else if let Some(last) = bracket.last_mut() {
-            *last = true;
-        }
-    }
-    bracket
 }

@@ -151,26 +151,41 @@ pub struct Scored {
     pub recover: Vec<usize>,
 }
 
+/// The first sample at or after time `t` (the number of samples if none).
+fn first_at_or_after<const N: usize>(data: &Reference<N>, t: f64) -> usize {
+    data.samples
+        .iter()
+        .position(|s| s.t >= t - 1e-12)
+        .unwrap_or(data.samples.len())
+}
+
+/// The samples that bracket a plant impact: the last before it and the
+/// first after it.
+pub fn brackets<const N: usize>(data: &Reference<N>) -> Vec<bool> {
+    let len = data.samples.len();
+    let mut bracket = vec![false; len];
+    for &(t, _, _) in &data.impacts {
+        let first = first_at_or_after(data, t);
+        if first < len {
+            bracket[first] = true;
+        }
+        if first > 0 {
+            bracket[first - 1] = true;
+        }
+    }
+    bracket
+}
+
 pub fn score<const N: usize>(
     data: &Reference<N>,
     estimates: &[Estimate<f64, N>],
     (from, to): (f64, f64),
 ) -> Scored {
     let errors = errors(data, estimates);
-    let mut bracket = vec![false; errors.len()];
+    let bracket = brackets(data);
     let mut recover = Vec::new();
     for &(t, _, _) in &data.impacts {
-        let first = data
-            .samples
-            .iter()
-            .position(|s| s.t >= t - 1e-12)
-            .unwrap_or(errors.len());
-        if first < errors.len() {
-            bracket[first] = true;
-        }
-        if first > 0 {
-            bracket[first - 1] = true;
-        }
+        let first = first_at_or_after(data, t);
         if t >= from {
             let back = (first..errors.len())
                 .find(|&j| errors[j] < 1e-2)
