@@ -180,8 +180,8 @@ fn f32_agrees_with_f64() {
 
 /// A degenerate enclosure: one `f64` point, each operation `f64`'s own
 /// (`sin` and `cos` those the generated `f64` code calls, the runtime's).
-/// Evaluated through `Enclosure`, it must give the `f64` methods' values
-/// bit for bit (same instruction list, same operations).
+/// Evaluated through `Enclosure`, it gives the `f64` methods' values (see
+/// `enclosures_at_points_are_the_f64_values` for how closely).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Pt(f64);
 
@@ -260,10 +260,11 @@ impl moreau::Enclose for Pt {
     }
 }
 
-fn enclosure_at_points<M, const N: usize, const K: usize, const NU: usize>(stem: &str)
+fn enclosure_at_points<M, const N: usize, const K: usize, const NU: usize>(stem: &str, ulps: f64)
 where
     M: moreau::Enclosure<N, K> + Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Default,
 {
+    let mut worst = 0.0f64;
     for (i, p) in points::<M, N, K, NU>(stem).iter().enumerate() {
         let (m, t, q, v, u) = (&p.model, p.t, &p.q, &p.v, &p.u);
         let qp: [Pt; N] = std::array::from_fn(|k| Pt(q[k]));
@@ -273,31 +274,48 @@ where
         let dfdv = m.linearization(t, q, v, u).forces_dv;
         let (em, ec) = (m.mass_enclosure(&qp), m.coriolis_enclosure(&qp, &vp));
         let ef = m.forces_dv_enclosure(Pt(t), &qp, &vp, &up);
-        for r in 0..N {
-            for c in 0..N {
-                assert_eq!(em[r][c].0.to_bits(), mass[(r, c)].to_bits(), "{stem} {i} M");
-                assert_eq!(
-                    ec[r][c].0.to_bits(),
-                    coriolis[(r, c)].to_bits(),
-                    "{stem} {i} C"
-                );
-                assert_eq!(
-                    ef[r][c].0.to_bits(),
-                    dfdv[(r, c)].to_bits(),
-                    "{stem} {i} ∂F/∂v"
-                );
+        // the scales of the CasADi comparison: C and ∂F/∂v are sums of
+        // (∂M/∂q) v, terms of size up to max|M| max|v|
+        let terms = mass.amax() * v.amax();
+        for (what, e, x, floor) in [
+            ("M", em, mass, 0.0),
+            ("C", ec, coriolis, terms),
+            ("∂F/∂v", ef, dfdv, terms),
+        ] {
+            // in units of the last place of that scale
+            let unit = x.amax().max(floor).max(f64::MIN_POSITIVE) * f64::EPSILON;
+            for r in 0..N {
+                for c in 0..N {
+                    let d = (e[r][c].0 - x[(r, c)]).abs() / unit;
+                    worst = worst.max(d);
+                    assert!(
+                        d <= ulps,
+                        "{stem} {i} {what}[{r},{c}]: {} against {} ({d} units)",
+                        e[r][c].0,
+                        x[(r, c)]
+                    );
+                }
             }
         }
     }
+    eprintln!("{stem}: largest difference {worst} units of the last place");
 }
 
+/// Where no wave of the model is shared the two instruction lists are one
+/// and the values agree bit for bit; the double pendulum and the arm build
+/// their `f64` waves of angle sums and differences from the angles' own by
+/// the addition formulas (`moreau_sym::graph::share_waves`), each formula a
+/// few roundings of numbers at most 1, while the enclosure code keeps one
+/// call per combination (a tighter interval): there they agree to a few
+/// units in the last place of the scale the CasADi comparison uses (the
+/// largest entry; for `C` and `∂F/∂v` at least max|M| max|v|).
 #[test]
 fn enclosures_at_points_are_the_f64_values() {
-    enclosure_at_points::<Parabola, 2, 2, 0>("parabola");
-    enclosure_at_points::<ThreeBalls, 3, 4, 0>("three_balls");
-    enclosure_at_points::<Billiard, 2, 4, 0>("billiard");
-    enclosure_at_points::<DoublePendulum, 2, 2, 0>("double_pendulum");
-    enclosure_at_points::<Arm3, 3, 1, 3>("arm3");
+    enclosure_at_points::<Parabola, 2, 2, 0>("parabola", 0.0);
+    enclosure_at_points::<ThreeBalls, 3, 4, 0>("three_balls", 0.0);
+    enclosure_at_points::<Billiard, 2, 4, 0>("billiard", 0.0);
+    enclosure_at_points::<DoublePendulum, 2, 2, 0>("double_pendulum", 4.0);
+    enclosure_at_points::<Arm3, 3, 1, 3>("arm3", 4.0);
 }
 
 /// What the compiler proves of the shipped models' structure, against what

@@ -5,8 +5,10 @@
 //! Variables are numbered by the model's [`VarLayout`]. Definitions are not
 //! variables: each is built once and its node reused wherever it is named.
 
+use moreau_sym::graph::share_waves;
 use moreau_sym::{
-    Graph, Id, Lagrangian, Mechanics, MechanicsError, Node, Operand, Recursive, Schedule, VarId,
+    Graph, Id, Lagrangian, Mechanics, MechanicsError, Node, Operand, Quantity, Recursive, Schedule,
+    VarId,
 };
 
 use crate::ctxt::Ctxt;
@@ -20,6 +22,11 @@ use crate::tree;
 pub(crate) struct Lowered {
     pub graph: Graph,
     pub mechanics: Mechanics,
+    /// `mechanics.outputs()` with the sines and cosines of angle
+    /// combinations shared across all of them
+    /// ([`share_waves`](moreau_sym::graph::share_waves)), those of the fused
+    /// evaluation first: what the code over the model's scalar computes.
+    pub outputs: Vec<Id>,
 }
 
 /// Builds the graph and derives the mechanics. Records an error and returns
@@ -83,7 +90,16 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
         Ok(mechanics) => {
             check_mass_diagonal(cx, model, &graph, &mechanics)?;
             check_finite_constants(cx, model, &graph, &mechanics)?;
-            Some(Lowered { graph, mechanics })
+            let outputs = mechanics.outputs();
+            let eval = mechanics.layout().indices(&Quantity::EVAL);
+            let fused: Vec<Id> = eval.iter().map(|&i| outputs[i]).collect();
+            let mut shared = share_waves(&mut graph, &[fused, outputs]);
+            let outputs = shared.pop().unwrap_or_default();
+            Some(Lowered {
+                graph,
+                mechanics,
+                outputs,
+            })
         }
         Err(e) => {
             report(cx, model, &e);

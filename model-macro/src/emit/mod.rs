@@ -54,7 +54,16 @@ pub(crate) fn listing(model: &Resolved<'_>, lowered: &Lowered) -> String {
 pub(crate) struct Emitter<'a, 'm> {
     model: &'a Resolved<'m>,
     outputs: Layout,
+    /// Every output, sines and cosines of angle combinations shared
+    /// (`moreau_sym::graph::share_waves`): the code over the model's scalar.
     full: Schedule,
+    /// Every output as derived, each wave one call on its combination: the
+    /// code over an enclosure type, where a wave built by the addition
+    /// formulas from its angles' would enclose a wider set (the product of
+    /// two intervals forgets that they are the sine and cosine of one
+    /// angle; with them the double pendulum's certification took 128 ms
+    /// instead of 15).
+    enclosed: Schedule,
     facts: Facts,
 }
 
@@ -104,15 +113,20 @@ impl<'a, 'm> Emitter<'a, 'm> {
         Emitter {
             model,
             outputs: mech.layout(),
-            full: Schedule::new(&lowered.graph, &mech.outputs()),
+            full: Schedule::new(&lowered.graph, &lowered.outputs),
+            enclosed: Schedule::new(&lowered.graph, &mech.outputs()),
             facts: Facts::of(model, lowered),
         }
     }
 
-    /// The body computing every entry of `qs`.
-    fn body(&self, qs: &[Quantity]) -> (Vec<usize>, Body) {
+    /// The body computing every entry of `qs` over `scalar`.
+    fn body(&self, scalar: Scalar, qs: &[Quantity]) -> (Vec<usize>, Body) {
         let indices = self.outputs.indices(qs);
-        let body = body::build(self.model, &self.full, &self.outputs, &indices);
+        let schedule = match scalar {
+            Scalar::Model => &self.full,
+            Scalar::Enclosure => &self.enclosed,
+        };
+        let body = body::build(self.model, schedule, &self.outputs, &indices);
         (indices, body)
     }
 
@@ -141,7 +155,7 @@ impl<'a, 'm> Emitter<'a, 'm> {
         qs: &[Quantity],
         ret: impl FnOnce(&[TokenStream]) -> TokenStream,
     ) -> TokenStream {
-        let (indices, body) = self.body(qs);
+        let (indices, body) = self.body(scalar, qs);
         let model = self.model;
         let statements = Tokens::of(scalar, |t| print::statements(t, model, &body));
         let entry = |slot: Slot| {
@@ -169,7 +183,7 @@ impl<'a, 'm> Emitter<'a, 'm> {
 
     /// The fused evaluation as text, with comments naming matrix entries.
     fn listing(&self) -> String {
-        let (indices, body) = self.body(&Quantity::EVAL);
+        let (indices, body) = self.body(Scalar::Model, &Quantity::EVAL);
         let mut text = Text(format!(
             "// {}: fused evaluation of M, C, G, F, h, J ({} operations)\n",
             self.model.spec.name.text,

@@ -168,7 +168,7 @@ fn long_bodies_are_cut_into_bounded_parts() {
     );
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("big.yaml");
     compiled(&path, text, |model, lowered| {
-        let (_, body) = Emitter::new(model, lowered).body(&Quantity::EVAL);
+        let (_, body) = Emitter::new(model, lowered).body(Scalar::Model, &Quantity::EVAL);
         let largest = body.lets.iter().map(|l| l.code.size()).max().unwrap();
         assert!(largest <= 2 * MAX_FOLD_SIZE, "{largest}");
         let weight: usize = body.lets.iter().map(|l| l.code.size()).sum();

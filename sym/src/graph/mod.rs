@@ -42,7 +42,7 @@
 mod simplify;
 mod trig;
 
-pub use trig::TrigForm;
+pub use trig::{TrigForm, share_waves};
 
 use std::collections::{HashMap, HashSet};
 use std::fmt;
@@ -372,6 +372,58 @@ impl Graph {
             new.insert(id, rebuilt);
         }
         new[&e]
+    }
+
+    /// `roots` with the nodes of `map` replaced by the given expressions,
+    /// everything above them rebuilt through the simplifying builders (a
+    /// node none of whose operands changed is kept as it is).
+    ///
+    /// ```
+    /// use std::collections::HashMap;
+    /// use moreau_sym::{Graph, VarId};
+    /// let mut g = Graph::new();
+    /// let (x, y) = (g.var(VarId(0)), g.var(VarId(1)));
+    /// let s = g.sin(x);
+    /// let e = g.mul(s, y);
+    /// let c = g.cos(x);
+    /// let r = g.replace(&[e, y], &HashMap::from([(s, c)]));
+    /// assert_eq!(r, vec![g.mul(c, y), y]);
+    /// ```
+    pub fn replace(&mut self, roots: &[Id], map: &HashMap<Id, Id>) -> Vec<Id> {
+        if map.is_empty() {
+            return roots.to_vec();
+        }
+        let mut new: HashMap<Id, Id> = HashMap::new();
+        for id in self.reachable(roots) {
+            let rebuilt = if let Some(&r) = map.get(&id) {
+                r
+            } else {
+                let mut node = self.node(id);
+                let mut changed = false;
+                let mut swap = |a: &mut Id| {
+                    let r = new[a];
+                    changed |= r != *a;
+                    *a = r;
+                };
+                match &mut node {
+                    Node::Add(ab)
+                    | Node::Sub(ab)
+                    | Node::Mul(ab)
+                    | Node::Div(ab)
+                    | Node::Pow(ab)
+                    | Node::Atan2(ab) => {
+                        let [a, b] = ab;
+                        swap(a);
+                        swap(b);
+                    }
+                    Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) => swap(a),
+                    Node::Const(_) | Node::Var(_) => {}
+                }
+                if changed { self.build(node) } else { id }
+            };
+            new.insert(id, rebuilt);
+        }
+        roots.iter().map(|r| new[r]).collect()
     }
 
     /// Formats `id` as an expression of the model language, with variables

@@ -75,9 +75,6 @@ pub struct TrigForm {
     memo: HashMap<Id, Option<Rc<Poly>>>,
     /// Rebuilt expression of each node normalised.
     done: HashMap<Id, Id>,
-    /// Whether waves of combinations are built from their angles' sines and
-    /// cosines ([`TrigForm::normal_all`] decides).
-    expand: bool,
 }
 
 impl TrigForm {
@@ -112,41 +109,19 @@ impl TrigForm {
             return n;
         }
         let n = match self.form(g, e) {
-            Some(p) => rebuild(g, &p, self.expand),
+            Some(p) => rebuild(g, &p),
             None => e,
         };
         self.done.insert(e, n);
         n
     }
 
-    /// Every entry of `entries` in the normal form, with one decision for
-    /// all of them on how a wave of a combination of angles is built: as
-    /// one `sin` or `cos` of the combination (the fewest operations, and
-    /// the tightest interval enclosure), unless the entries hold at least
-    /// as many distinct combinations as angles, and more than two angles,
-    /// as a chain's `N(N−1)/2` differences of `N ≥ 3` angles do; then from
-    /// the angles' own sines and cosines by the addition formulas (a
-    /// product costs a fraction of a nanosecond where a `sin_cos` costs
-    /// tens, and the angles' own are computed for `G` and the gaps anyway).
-    /// The three-link arm (one combination of two angles in `M`) and the
-    /// double pendulum keep their single calls; the chains from three links
-    /// on are expanded (`MOREAU_BENCH_REPS=101 cargo bench -p moreau-bench
-    /// --bench model_eval`: the 10-link chain's evaluation 434 → 154 ns).
+    /// Every entry of `entries` in the normal form, each wave one call on
+    /// its combination (`sin(q2 + q3)`, the fewest operations and the
+    /// tightest interval enclosure). Whether a wave is better built from
+    /// other waves by the addition formulas is decided later, once for all
+    /// quantities of a model, by [`share_waves`].
     pub fn normal_all(&mut self, g: &mut Graph, entries: &[Id]) -> Vec<Id> {
-        let mut combinations = std::collections::BTreeSet::new();
-        let mut angles = std::collections::BTreeSet::new();
-        for &e in entries {
-            let Some(p) = self.form(g, e) else { continue };
-            for (_, w) in p.keys() {
-                if let Wave::Cos(f) | Wave::Sin(f) = w {
-                    angles.extend(f.iter().map(|&(x, _)| x));
-                    if f.len() > 1 || f.iter().any(|&(_, k)| k.abs() > 1) {
-                        combinations.insert(f.clone());
-                    }
-                }
-            }
-        }
-        self.expand = combinations.len() >= angles.len() && angles.len() > 2;
         entries.iter().map(|&e| self.normal(g, e)).collect()
     }
 
@@ -422,43 +397,20 @@ fn linear(g: &Graph, c: f64, e: Id, out: &mut Vec<(f64, Id)>, budget: &mut usize
 
 /// The expression of a form: atoms factored out greedily, each wave built
 /// once (so `sin` and `cos` of one combination share its argument).
-fn rebuild(g: &mut Graph, p: &Poly, expand: bool) -> Id {
+fn rebuild(g: &mut Graph, p: &Poly) -> Id {
     let terms: Vec<(f64, Vec<(Id, u32)>)> = p
         .iter()
         .map(|((atoms, w), &k)| {
             let mut atoms = atoms.clone();
-            if let Some(x) = wave_node(g, w, expand) {
-                atoms.push((x, 1));
+            match w {
+                Wave::One => {}
+                Wave::Cos(x) => atoms.push((combination(g, Func::Cos, x), 1)),
+                Wave::Sin(x) => atoms.push((combination(g, Func::Sin, x), 1)),
             }
             (k, atoms)
         })
         .collect();
     horner(g, terms)
-}
-
-/// The node of a wave, `None` for [`Wave::One`].
-///
-/// With `expand`, a combination `Σ k_i a_i` is built from the sines and
-/// cosines of its angles by the addition formulas
-/// (`cos(a − b) = cos a cos b + sin a sin b`; the graph shares the partial
-/// combinations); otherwise as one call on the combination, whose argument
-/// reads `a + b − c`.
-fn wave_node(g: &mut Graph, w: &Wave, expand: bool) -> Option<Id> {
-    let (f, freq) = match w {
-        Wave::One => return None,
-        Wave::Cos(x) => (Func::Cos, x),
-        Wave::Sin(x) => (Func::Sin, x),
-    };
-    if !expand {
-        return Some(combination(g, f, freq));
-    }
-    // one angle at a time, each multiple as repeated angles
-    let angles: Vec<(Id, bool)> = freq
-        .iter()
-        .flat_map(|&(x, k)| core::iter::repeat_n((x, k < 0), k.unsigned_abs() as usize))
-        .collect();
-    let (sin, cos) = addition(g, &angles)?;
-    Some(if f == Func::Sin { sin } else { cos })
 }
 
 /// `f(Σ k_i a_i)` as one call on the combination.
@@ -483,24 +435,6 @@ fn combination(g: &mut Graph, f: Func, freq: &Freq) -> Id {
     }
     let arg = acc.expect("a wave has an angle");
     g.func(f, arg)
-}
-
-/// `(sin, cos)` of `Σ ±a_i` over `angles` (`true` for a minus), by the
-/// addition formulas from the last angle back; `None` for no angle.
-fn addition(g: &mut Graph, angles: &[(Id, bool)]) -> Option<(Id, Id)> {
-    let (&(x, minus), rest) = angles.split_first()?;
-    let sin_x = g.func(Func::Sin, x);
-    let cos_x = g.func(Func::Cos, x);
-    let sin_x = if minus { g.neg(sin_x) } else { sin_x };
-    let Some((sin_r, cos_r)) = addition(g, rest) else {
-        return Some((sin_x, cos_x));
-    };
-    // sin(x + r) = sin x cos r + cos x sin r, cos(x + r) = cos x cos r − sin x sin r
-    let (a, b) = (g.mul(sin_x, cos_r), g.mul(cos_x, sin_r));
-    let sin = g.add(a, b);
-    let (c, d) = (g.mul(cos_x, cos_r), g.mul(sin_x, sin_r));
-    let cos = g.sub(c, d);
-    Some((sin, cos))
 }
 
 /// `Σ k_m Π x^e` with the factor of most terms pulled out first.
@@ -565,4 +499,147 @@ fn horner(g: &mut Graph, terms: Vec<(f64, Vec<(Id, u32)>)>) -> Id {
         });
     }
     acc.unwrap_or_else(|| g.constant(0.0))
+}
+
+/// Sines and cosines of integer combinations of angles shared across every
+/// expression of `phases`: each combination that is a sum or a difference
+/// of two combinations already at hand is built from their sines and
+/// cosines by the addition formulas (four products and two sums for both),
+/// the others by one call on the combination (which the emitter pairs into
+/// one `sin_cos`).
+///
+/// This is the one place that decides how a wave is built, for all
+/// quantities at once: a two-link chain's `M` holds `cos(θ1 − θ2)` while
+/// its `G` and gaps hold `sin θ1`, `cos θ1`, `sin θ2`, `cos θ2`; the
+/// three-link arm's `M` holds waves of `q2`, `q3` and `q2 + q3`, its
+/// gaps waves of `q1`, `q1 + q2` and `q1 + q2 + q3`. Taken one quantity
+/// at a time neither repeats a call; taken together three `sin_cos`
+/// calls give all six combinations of the arm (a call costs about 5 ns,
+/// the formulas a fraction of one).
+///
+/// The combinations of each phase (its expressions' reachable `sin` and
+/// `cos` of an integer combination, sign-normalised) are taken in order
+/// of their size (`Σ |k_i|`, then number of angles), so single angles are
+/// called and sums and differences derived; a combination of a phase is
+/// derived only from combinations of that phase or of the phases before
+/// it, so an earlier phase (the fused evaluation) never computes a call
+/// for the sake of a later one (the derivatives). Among several ways to
+/// derive one, the shallowest (fewest formulas stacked on a call) is
+/// taken: a derived value carries an absolute error of a few units in the
+/// last place per level.
+///
+/// Returns the expressions of each phase, rebuilt; an expression without
+/// such a wave comes back as it was.
+///
+/// ```
+/// use moreau_sym::{graph::share_waves, Graph, VarId};
+/// let mut g = Graph::new();
+/// let (a, b) = (g.var(VarId(0)), g.var(VarId(1)));
+/// let d = g.sub(a, b);
+/// let (sa, ca, sb, cb, cd) = (g.sin(a), g.cos(a), g.sin(b), g.cos(b), g.cos(d));
+/// let shared = share_waves(&mut g, &[vec![sa, ca, sb, cb, cd]]);
+/// // cos(a − b) is now cos a cos b + sin a sin b: no fifth call
+/// let cc = g.mul(ca, cb);
+/// let ss = g.mul(sa, sb);
+/// assert_eq!(shared[0][4], g.add(cc, ss));
+/// assert_eq!(shared[0][..4], [sa, ca, sb, cb]);
+/// ```
+pub fn share_waves(g: &mut Graph, phases: &[Vec<Id>]) -> Vec<Vec<Id>> {
+    /// A combination at hand: its `sin`, its `cos`, and how many formulas
+    /// stand between it and a call.
+    type Hand = (Id, Id, u32);
+    let mut hand: BTreeMap<Freq, Hand> = BTreeMap::new();
+    let mut seen: BTreeMap<Freq, ()> = BTreeMap::new();
+    // each sin/cos node of a combination: (node, function, combination, sign flipped)
+    let mut nodes: Vec<(Id, Func, Freq, bool)> = Vec::new();
+    for roots in phases {
+        let mut fresh: Vec<Freq> = Vec::new();
+        for id in g.reachable(roots) {
+            let Node::Func(f @ (Func::Sin | Func::Cos), a) = g.node(id) else {
+                continue;
+            };
+            let Some(freq) = angle(g, a) else { continue };
+            let Some(&(_, first)) = freq.first() else {
+                continue;
+            };
+            let (freq, flipped) = if first < 0 {
+                (freq.into_iter().map(|(x, k)| (x, -k)).collect(), true)
+            } else {
+                (freq, false)
+            };
+            if seen.insert(freq.clone(), ()).is_none() {
+                fresh.push(freq.clone());
+            }
+            nodes.push((id, f, freq, flipped));
+        }
+        let size = |f: &Freq| {
+            (
+                f.iter().map(|&(_, k)| k.unsigned_abs()).sum::<u32>(),
+                f.len(),
+            )
+        };
+        fresh.sort_by(|x, y| size(x).cmp(&size(y)).then_with(|| x.cmp(y)));
+        for freq in fresh {
+            let built = derive(g, &hand, &freq).unwrap_or_else(|| {
+                let sin = combination(g, Func::Sin, &freq);
+                let cos = combination(g, Func::Cos, &freq);
+                (sin, cos, 0)
+            });
+            hand.insert(freq, built);
+        }
+    }
+    let mut map: HashMap<Id, Id> = HashMap::new();
+    for (id, f, freq, flipped) in nodes {
+        let (sin, cos, _) = hand[&freq];
+        let new = match (f, flipped) {
+            (Func::Cos, _) => cos,
+            (_, false) => sin,
+            (_, true) => g.neg(sin),
+        };
+        if new != id {
+            map.insert(id, new);
+        }
+    }
+    phases.iter().map(|roots| g.replace(roots, &map)).collect()
+}
+
+/// `(sin, cos)` of `freq` from two combinations at hand whose sum or
+/// difference it is, the shallowest such pair; `None` if there is none.
+fn derive(
+    g: &mut Graph,
+    hand: &BTreeMap<Freq, (Id, Id, u32)>,
+    freq: &Freq,
+) -> Option<(Id, Id, u32)> {
+    let mut best: Option<(u32, &Freq, Freq, bool)> = None;
+    for (x, &(_, _, dx)) in hand {
+        // freq = x + s·y with y at hand in canonical sign
+        let rest = combine(freq, x, -1);
+        let Some(&(_, first)) = rest.first() else {
+            continue;
+        };
+        let (y, minus) = if first < 0 {
+            (rest.into_iter().map(|(a, k)| (a, -k)).collect(), true)
+        } else {
+            (rest, false)
+        };
+        let Some(&(_, _, dy)) = hand.get(&y) else {
+            continue;
+        };
+        let depth = dx.max(dy) + 1;
+        if best.as_ref().is_none_or(|b| depth < b.0) {
+            best = Some((depth, x, y, minus));
+        }
+    }
+    let (depth, x, y, minus) = best?;
+    let (sx, cx, _) = hand[x];
+    let (sy, cy, _) = hand[&y];
+    // sin(x ± y) = sin x cos y ± cos x sin y, cos(x ± y) = cos x cos y ∓ sin x sin y
+    let (a, b) = (g.mul(sx, cy), g.mul(cx, sy));
+    let (c, d) = (g.mul(cx, cy), g.mul(sx, sy));
+    let (sin, cos) = if minus {
+        (g.sub(a, b), g.add(c, d))
+    } else {
+        (g.add(a, b), g.sub(c, d))
+    };
+    Some((sin, cos, depth))
 }
