@@ -307,6 +307,32 @@ impl Node {
         }
     }
 
+    /// The same operation on the operands `f` maps each operand to (leaves
+    /// unchanged).
+    ///
+    /// ```
+    /// use moreau_sym::{Func, Graph, Node, VarId};
+    /// let mut g = Graph::new();
+    /// let (x, y) = (g.var(VarId(0)), g.var(VarId(1)));
+    /// let s = g.sin(x);
+    /// assert_eq!(g.node(s).map_children(|_| y), Node::Func(Func::Sin, y));
+    /// assert_eq!(g.node(x).map_children(|_| y), Node::Var(VarId(0)));
+    /// ```
+    #[must_use]
+    pub fn map_children(mut self, mut f: impl FnMut(Id) -> Id) -> Node {
+        match &mut self {
+            Node::Const(_) | Node::Var(_) => {}
+            Node::Add(ab)
+            | Node::Sub(ab)
+            | Node::Mul(ab)
+            | Node::Div(ab)
+            | Node::Pow(ab)
+            | Node::Atan2(ab) => *ab = [f(ab[0]), f(ab[1])],
+            Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) => *a = f(*a),
+        }
+        self
+    }
+
     /// The operation of a non-leaf node, `None` for constants and variables.
     #[must_use]
     pub fn op(&self) -> Option<Op> {

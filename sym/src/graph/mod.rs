@@ -352,20 +352,7 @@ impl Graph {
                 Node::Const(_) => id,
                 _ if map.iter().all(|&(v, _)| !self.depends_on(id, v)) => id,
                 _ => {
-                    let mut node = node;
-                    match &mut node {
-                        Node::Add(ab)
-                        | Node::Sub(ab)
-                        | Node::Mul(ab)
-                        | Node::Div(ab)
-                        | Node::Pow(ab)
-                        | Node::Atan2(ab) => {
-                            ab[0] = new[&ab[0]];
-                            ab[1] = new[&ab[1]];
-                        }
-                        Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) => *a = new[a],
-                        Node::Const(_) | Node::Var(_) => unreachable!(),
-                    }
+                    let node = node.map_children(|a| new[&a]);
                     self.build(node)
                 }
             };
@@ -398,28 +385,13 @@ impl Graph {
             let rebuilt = if let Some(&r) = map.get(&id) {
                 r
             } else {
-                let mut node = self.node(id);
-                let mut changed = false;
-                let mut swap = |a: &mut Id| {
-                    let r = new[a];
-                    changed |= r != *a;
-                    *a = r;
-                };
-                match &mut node {
-                    Node::Add(ab)
-                    | Node::Sub(ab)
-                    | Node::Mul(ab)
-                    | Node::Div(ab)
-                    | Node::Pow(ab)
-                    | Node::Atan2(ab) => {
-                        let [a, b] = ab;
-                        swap(a);
-                        swap(b);
-                    }
-                    Node::Neg(a) | Node::Powi(a, _) | Node::Func(_, a) => swap(a),
-                    Node::Const(_) | Node::Var(_) => {}
+                let node = self.node(id);
+                let mapped = node.map_children(|a| new[&a]);
+                if mapped == node {
+                    id
+                } else {
+                    self.build(mapped)
                 }
-                if changed { self.build(node) } else { id }
             };
             new.insert(id, rebuilt);
         }

@@ -559,6 +559,9 @@ mod trig {
         let ab = g.mul(a, b);
         let a1 = g.add(a, one);
         let roots = vec![g.sin(ab), g.cos(a1), g.sin(a)];
-        assert_eq!(share_waves(&mut g, &[roots.clone()]), vec![roots]);
+        assert_eq!(
+            share_waves(&mut g, std::slice::from_ref(&roots)),
+            vec![roots]
+        );
     }
 }

@@ -558,14 +558,8 @@ pub fn share_waves(g: &mut Graph, phases: &[Vec<Id>]) -> Vec<Vec<Id>> {
             let Node::Func(f @ (Func::Sin | Func::Cos), a) = g.node(id) else {
                 continue;
             };
-            let Some(freq) = angle(g, a) else { continue };
-            let Some(&(_, first)) = freq.first() else {
+            let Some((freq, flipped)) = angle(g, a).and_then(leading_positive) else {
                 continue;
-            };
-            let (freq, flipped) = if first < 0 {
-                (freq.into_iter().map(|(x, k)| (x, -k)).collect(), true)
-            } else {
-                (freq, false)
             };
             if seen.insert(freq.clone(), ()).is_none() {
                 fresh.push(freq.clone());
@@ -603,6 +597,17 @@ pub fn share_waves(g: &mut Graph, phases: &[Vec<Id>]) -> Vec<Vec<Id>> {
     phases.iter().map(|roots| g.replace(roots, &map)).collect()
 }
 
+/// `freq` with its first coefficient positive, and whether it was negated;
+/// `None` for the empty combination.
+fn leading_positive(freq: Freq) -> Option<(Freq, bool)> {
+    let &(_, first) = freq.first()?;
+    Some(if first < 0 {
+        (freq.into_iter().map(|(x, k)| (x, -k)).collect(), true)
+    } else {
+        (freq, false)
+    })
+}
+
 /// `(sin, cos)` of `freq` from two combinations at hand whose sum or
 /// difference it is, the shallowest such pair; `None` if there is none.
 fn derive(
@@ -613,14 +618,8 @@ fn derive(
     let mut best: Option<(u32, &Freq, Freq, bool)> = None;
     for (x, &(_, _, dx)) in hand {
         // freq = x + s·y with y at hand in canonical sign
-        let rest = combine(freq, x, -1);
-        let Some(&(_, first)) = rest.first() else {
+        let Some((y, minus)) = leading_positive(combine(freq, x, -1)) else {
             continue;
-        };
-        let (y, minus) = if first < 0 {
-            (rest.into_iter().map(|(a, k)| (a, -k)).collect(), true)
-        } else {
-            (rest, false)
         };
         let Some(&(_, _, dy)) = hand.get(&y) else {
             continue;
