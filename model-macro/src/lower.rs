@@ -93,8 +93,7 @@ pub(crate) fn lower(cx: &Ctxt, model: &Resolved<'_>) -> Option<Lowered> {
             let outputs = mechanics.outputs();
             let eval = mechanics.layout().indices(&Quantity::EVAL);
             let fused: Vec<Id> = eval.iter().map(|&i| outputs[i]).collect();
-            let mut shared = share_waves(&mut graph, &[fused, outputs]);
-            let outputs = shared.pop().unwrap_or_default();
+            let outputs = share_waves(&mut graph, &outputs, &fused);
             Some(Lowered {
                 graph,
                 mechanics,

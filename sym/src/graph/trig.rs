@@ -27,7 +27,7 @@
 //! past [`MAX_TERMS`] monomials in any subexpression and keeps the
 //! expression as it was.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::rc::Rc;
 
 use super::Graph;
@@ -502,7 +502,7 @@ fn horner(g: &mut Graph, terms: Vec<(f64, Vec<(Id, u32)>)>) -> Id {
 }
 
 /// Sines and cosines of integer combinations of angles shared across every
-/// expression of `phases`: each combination that is a sum or a difference
+/// expression of `roots`: each combination that is a sum or a difference
 /// of two combinations already at hand is built from their sines and
 /// cosines by the addition formulas (four products and two sums for both),
 /// the others by one call on the combination (which the emitter pairs into
@@ -517,19 +517,18 @@ fn horner(g: &mut Graph, terms: Vec<(f64, Vec<(Id, u32)>)>) -> Id {
 /// calls give all six combinations of the arm (a call costs about 5 ns,
 /// the formulas a fraction of one).
 ///
-/// The combinations of each phase (its expressions' reachable `sin` and
-/// `cos` of an integer combination, sign-normalised) are taken in order
-/// of their size (`Σ |k_i|`, then number of angles), so single angles are
-/// called and sums and differences derived; a combination of a phase is
-/// derived only from combinations of that phase or of the phases before
-/// it, so an earlier phase (the fused evaluation) never computes a call
-/// for the sake of a later one (the derivatives). Among several ways to
-/// derive one, the shallowest (fewest formulas stacked on a call) is
-/// taken: a derived value carries an absolute error of a few units in the
-/// last place per level.
+/// The combinations (the reachable `sin` and `cos` of an integer
+/// combination, sign-normalised) are taken in order of their size
+/// (`Σ |k_i|`, then number of angles), so single angles are called and
+/// sums and differences derived; those reachable from `first` (the fused
+/// evaluation) are all taken before the others and derived only from each
+/// other, so that `first` never computes a call for the sake of the rest
+/// (the derivatives). Among several ways to derive one, the shallowest
+/// (fewest formulas stacked on a call) is taken: a derived value carries
+/// an absolute error of a few units in the last place per level.
 ///
-/// Returns the expressions of each phase, rebuilt; an expression without
-/// such a wave comes back as it was.
+/// Returns `roots` rebuilt; an expression without such a wave comes back
+/// as it was.
 ///
 /// ```
 /// use moreau_sym::{graph::share_waves, Graph, VarId};
@@ -537,42 +536,44 @@ fn horner(g: &mut Graph, terms: Vec<(f64, Vec<(Id, u32)>)>) -> Id {
 /// let (a, b) = (g.var(VarId(0)), g.var(VarId(1)));
 /// let d = g.sub(a, b);
 /// let (sa, ca, sb, cb, cd) = (g.sin(a), g.cos(a), g.sin(b), g.cos(b), g.cos(d));
-/// let shared = share_waves(&mut g, &[vec![sa, ca, sb, cb, cd]]);
+/// let shared = share_waves(&mut g, &[sa, ca, sb, cb, cd], &[]);
 /// // cos(a − b) is now cos a cos b + sin a sin b: no fifth call
 /// let cc = g.mul(ca, cb);
 /// let ss = g.mul(sa, sb);
-/// assert_eq!(shared[0][4], g.add(cc, ss));
-/// assert_eq!(shared[0][..4], [sa, ca, sb, cb]);
+/// assert_eq!(shared[4], g.add(cc, ss));
+/// assert_eq!(shared[..4], [sa, ca, sb, cb]);
 /// ```
-pub fn share_waves(g: &mut Graph, phases: &[Vec<Id>]) -> Vec<Vec<Id>> {
+pub fn share_waves(g: &mut Graph, roots: &[Id], first: &[Id]) -> Vec<Id> {
     /// A combination at hand: its `sin`, its `cos`, and how many formulas
     /// stand between it and a call.
     type Hand = (Id, Id, u32);
+    let size = |f: &Freq| {
+        (
+            f.iter().map(|&(_, k)| k.unsigned_abs()).sum::<u32>(),
+            f.len(),
+        )
+    };
     let mut hand: BTreeMap<Freq, Hand> = BTreeMap::new();
-    let mut seen: BTreeMap<Freq, ()> = BTreeMap::new();
-    // each sin/cos node of a combination: (node, function, combination, sign flipped)
-    let mut nodes: Vec<(Id, Func, Freq, bool)> = Vec::new();
-    for roots in phases {
-        let mut fresh: Vec<Freq> = Vec::new();
-        for id in g.reachable(roots) {
+    // each sin/cos node of a combination: its function, combination, and
+    // whether the combination was negated
+    let mut nodes: HashMap<Id, (Func, Freq, bool)> = HashMap::new();
+    for phase in [first, roots] {
+        let mut fresh: BTreeSet<Freq> = BTreeSet::new();
+        for id in g.reachable(phase) {
             let Node::Func(f @ (Func::Sin | Func::Cos), a) = g.node(id) else {
                 continue;
             };
             let Some((freq, flipped)) = angle(g, a).and_then(leading_positive) else {
                 continue;
             };
-            if seen.insert(freq.clone(), ()).is_none() {
-                fresh.push(freq.clone());
+            if !hand.contains_key(&freq) {
+                fresh.insert(freq.clone());
             }
-            nodes.push((id, f, freq, flipped));
+            nodes.insert(id, (f, freq, flipped));
         }
-        let size = |f: &Freq| {
-            (
-                f.iter().map(|&(_, k)| k.unsigned_abs()).sum::<u32>(),
-                f.len(),
-            )
-        };
-        fresh.sort_by(|x, y| size(x).cmp(&size(y)).then_with(|| x.cmp(y)));
+        // by size; the set's order among equal sizes
+        let mut fresh: Vec<Freq> = fresh.into_iter().collect();
+        fresh.sort_by_key(size);
         for freq in fresh {
             let built = derive(g, &hand, &freq).unwrap_or_else(|| {
                 let sin = combination(g, Func::Sin, &freq);
@@ -583,7 +584,7 @@ pub fn share_waves(g: &mut Graph, phases: &[Vec<Id>]) -> Vec<Vec<Id>> {
         }
     }
     let mut map: HashMap<Id, Id> = HashMap::new();
-    for (id, f, freq, flipped) in nodes {
+    for (id, (f, freq, flipped)) in nodes {
         let (sin, cos, _) = hand[&freq];
         let new = match (f, flipped) {
             (Func::Cos, _) => cos,
@@ -594,7 +595,7 @@ pub fn share_waves(g: &mut Graph, phases: &[Vec<Id>]) -> Vec<Vec<Id>> {
             map.insert(id, new);
         }
     }
-    phases.iter().map(|roots| g.replace(roots, &map)).collect()
+    g.replace(roots, &map)
 }
 
 /// `freq` with its first coefficient positive, and whether it was negated;

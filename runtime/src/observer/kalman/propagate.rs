@@ -123,6 +123,15 @@ where
             projections: 0,
         }
     }
+
+    /// Carries the mean delay's offset through the linear map `map` (a
+    /// piece's transition, an impact's saltation, a projection). Nothing
+    /// to carry, and no work, without a mean delay (the default).
+    fn carry_offset(&mut self, map: &Blocks<T, N>) {
+        if self.delay != T::zero() {
+            self.offset = map.apply(&self.offset.0, &self.offset.1);
+        }
+    }
 }
 
 /// White acceleration noise of density `d` (a symmetric `N × N` matrix)
@@ -219,7 +228,7 @@ where
         let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
         let phi = transition(&a, piece.h);
         let mut p = phi.congruence(&self.p).add(&noise);
-        self.offset = phi.apply(&self.offset.0, &self.offset.1);
+        self.carry_offset(&phi);
         self.correction = (SVector::zeros(), SVector::zeros());
         if !held.is_empty() {
             // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
@@ -239,7 +248,7 @@ where
             {
                 p = projection.p;
                 self.correction = (projection.dq, projection.dv);
-                self.offset = projection.map.apply(&self.offset.0, &self.offset.1);
+                self.carry_offset(&projection.map);
                 self.projections += 1;
             }
             // what the contact leaves uncertain across it: the noise's
@@ -298,15 +307,13 @@ where
         )?;
         let noise = self.impact_noise(&s, jump.p, &w)?;
         self.p = s.matrix.congruence(&self.p).add(&noise).symmetrized();
-        let (dq, dv) = s.matrix.apply(&self.offset.0, &self.offset.1);
+        self.carry_offset(&s.matrix);
         // the mean delay, for an impact that a gap's root timed (a closure
         // the LCP makes at the start of a piece has no instant to delay)
-        let delay = if guard.is_some() {
-            self.delay
-        } else {
-            T::zero()
-        };
-        self.offset = (dq + s.timing.0 * delay, dv + s.timing.1 * delay);
+        if guard.is_some() && self.delay != T::zero() {
+            self.offset.0 += s.timing.0 * self.delay;
+            self.offset.1 += s.timing.1 * self.delay;
+        }
         self.saltations += 1;
         Ok(())
     }
