@@ -54,8 +54,8 @@ pub enum DataError<T> {
         /// Its coefficient.
         value: T,
     },
-    /// `M(q)` is not positive definite where it was evaluated (its Cholesky
-    /// factorization failed).
+    /// `M(q)` is not positive definite where it was evaluated (a pivot of its
+    /// `L D Lᵀ` factorization is not positive).
     MassNotPositiveDefinite,
     /// The model returned a NaN or an infinity (overflow, or a function
     /// outside its domain, such as `sqrt` of a negative number).

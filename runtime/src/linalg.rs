@@ -98,56 +98,71 @@ impl<T: RealField + Copy, const N: usize> Lu<T, N> {
     }
 }
 
-/// `A = L Lᵀ` for symmetric positive definite `A` (the lower triangle is
-/// read).
+/// `A = L D Lᵀ` for symmetric positive definite `A` (the lower triangle
+/// is read): `L` unit lower triangular, `D` diagonal and positive.
+///
+/// The square-root-free form of Cholesky's factorization, as backward
+/// stable for a positive definite `A`, and shorter where a model's update
+/// waits for it: a factorization and one solve of a 2 × 2 `M` is a chain of
+/// two divisions (`l₂₁ = a₂₁/d₁`, then `x₂ = y₂/d₂` after `d₂ = a₂₂ −
+/// l₂₁a₂₁`), where `L Lᵀ` chains two square roots and five divisions
+/// (`l₁₁`, `l₂₁`, `l₂₂`, then `y₂ = …/l₂₂`, `x₂ = y₂/l₂₂`, `x₁ = …/l₁₁`).
+/// The divisions of a solve by `D` are independent of each other; a
+/// diagonal `A` is solved by one correctly rounded division per entry.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Cholesky<T: RealField + Copy, const N: usize> {
-    l: SMatrix<T, N, N>,
+pub(crate) struct Ldlt<T: RealField + Copy, const N: usize> {
+    /// `L` strictly below the diagonal, `D` on it, `L D` (`l_ij d_j`,
+    /// transposed) above it.
+    f: SMatrix<T, N, N>,
 }
 
-impl<T: RealField + Copy, const N: usize> Cholesky<T, N> {
+impl<T: RealField + Copy, const N: usize> Ldlt<T, N> {
     /// Factors `a`; `None` when `a` is not (numerically) positive definite
-    /// or not finite.
+    /// (a pivot `d_j` not positive) or not finite.
     pub fn new(a: &SMatrix<T, N, N>) -> Option<Self> {
-        let mut l = SMatrix::<T, N, N>::zeros();
+        let mut f = SMatrix::<T, N, N>::zeros();
         for j in 0..N {
             let mut d = a[(j, j)];
             for k in 0..j {
-                d -= l[(j, k)] * l[(j, k)];
+                d -= f[(j, k)] * f[(k, j)];
             }
             if !(d > T::zero() && d.is_finite()) {
                 return None;
             }
-            let d = d.sqrt();
-            l[(j, j)] = d;
+            f[(j, j)] = d;
             for i in j + 1..N {
+                // `s = l_ij d_j`
                 let mut s = a[(i, j)];
                 for k in 0..j {
-                    s -= l[(i, k)] * l[(j, k)];
+                    s -= f[(i, k)] * f[(k, j)];
                 }
-                l[(i, j)] = s / d;
+                f[(j, i)] = s;
+                f[(i, j)] = s / d;
             }
         }
-        Some(Self { l })
+        Some(Self { f })
     }
 
-    /// `A⁻¹ b`, column by column.
+    /// `A⁻¹ b`, column by column: `L y = b`, `z = D⁻¹ y`, `Lᵀ x = z`.
     pub fn solve<const C: usize>(&self, b: &SMatrix<T, N, C>) -> SMatrix<T, N, C> {
         let mut x = *b;
         for c in 0..C {
             for i in 0..N {
                 let mut s = x[(i, c)];
                 for k in 0..i {
-                    s -= self.l[(i, k)] * x[(k, c)];
+                    s -= self.f[(i, k)] * x[(k, c)];
                 }
-                x[(i, c)] = s / self.l[(i, i)];
+                x[(i, c)] = s;
+            }
+            for i in 0..N {
+                x[(i, c)] /= self.f[(i, i)];
             }
             for i in (0..N).rev() {
                 let mut s = x[(i, c)];
                 for k in i + 1..N {
-                    s -= self.l[(k, i)] * x[(k, c)];
+                    s -= self.f[(k, i)] * x[(k, c)];
                 }
-                x[(i, c)] = s / self.l[(i, i)];
+                x[(i, c)] = s;
             }
         }
         x
@@ -291,20 +306,43 @@ mod tests {
     }
 
     #[test]
-    fn cholesky_solves_and_rejects_indefinite() {
+    fn ldlt_solves_and_rejects_indefinite() {
         let a = Matrix3::new(4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0);
         let x = Vector3::new(0.3, -1.0, 2.0);
-        let c = Cholesky::new(&a).unwrap();
+        let c = Ldlt::new(&a).unwrap();
         assert!((c.solve(&(a * x)) - x).amax() < 1e-14);
         let indefinite = Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-        assert!(Cholesky::new(&indefinite).is_none());
+        assert!(Ldlt::new(&indefinite).is_none());
+        assert!(Ldlt::new(&Matrix3::from_element(f64::NAN)).is_none());
+    }
+
+    #[test]
+    fn ldlt_agrees_with_nalgebras_cholesky() {
+        // `A = Bᵀ B + I` for a fixed, ill-scaled `B`: positive definite,
+        // condition number about 1e4
+        let b = SMatrix::<f64, 6, 6>::from_fn(|i, j| {
+            ((i * 7 + j * 3) as f64 * 0.37).sin() * 10f64.powi(i as i32 % 3 - 1)
+        });
+        let a = b.transpose() * b + SMatrix::<f64, 6, 6>::identity();
+        let rhs = SMatrix::<f64, 6, 2>::from_fn(|i, j| (i as f64 - 2.5) * (j as f64 + 1.0));
+        let ours = Ldlt::new(&a).unwrap().solve(&rhs);
+        let theirs = nalgebra::Cholesky::new(a).unwrap().solve(&rhs);
+        assert!((ours - theirs).amax() <= 1e-12 * theirs.amax());
+    }
+
+    #[test]
+    fn ldlt_of_a_diagonal_divides_once() {
+        let a = Matrix3::from_diagonal(&Vector3::new(3.0, 7.0, 0.1));
+        let b = Vector3::new(1.0, -2.0, 0.3);
+        let x = Ldlt::new(&a).unwrap().solve(&b);
+        assert_eq!(x, Vector3::new(1.0 / 3.0, -2.0 / 7.0, 0.3 / 0.1));
     }
 
     #[test]
     fn zero_sized_systems_are_trivial() {
         let a = SMatrix::<f64, 0, 0>::zeros();
         assert!(Lu::new(&a).is_some());
-        assert!(Cholesky::new(&a).is_some());
+        assert!(Ldlt::new(&a).is_some());
     }
 
     #[test]

@@ -5,7 +5,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::error::DataError;
-use crate::linalg::Cholesky;
+use crate::linalg::Ldlt;
 use crate::model::Model;
 
 /// Rejects a vector of the state or of a measurement that holds a NaN or
@@ -36,9 +36,9 @@ pub(crate) fn finite_model<T: RealField + Copy, const R: usize, const C: usize>(
 #[inline]
 pub(crate) fn factor_mass<T: RealField + Copy, const N: usize>(
     mass: &SMatrix<T, N, N>,
-) -> Result<Cholesky<T, N>, DataError<T>> {
+) -> Result<Ldlt<T, N>, DataError<T>> {
     finite_model(mass, "M")?;
-    Cholesky::new(mass).ok_or(DataError::MassNotPositiveDefinite)
+    Ldlt::new(mass).ok_or(DataError::MassNotPositiveDefinite)
 }
 
 /// The diagonal of a diagonal `M`, rejecting a non-finite or indefinite

@@ -3,7 +3,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::Lcp;
-use crate::linalg::{Cholesky, SymmetricEigen};
+use crate::linalg::{Ldlt, SymmetricEigen};
 use crate::model::Model;
 
 use super::interval::{Cache, Interval, Memory, saturate, saturate_for};
@@ -147,7 +147,7 @@ impl<T: RealField + Copy, const N: usize> FlowMemo<T, N> {
     fn get(
         &mut self,
         tau: T,
-        chol: &Cholesky<T, N>,
+        chol: &Ldlt<T, N>,
         gains: &FullOrderGains<T, N>,
         l_d: T,
     ) -> ErrorFlow<T, N> {

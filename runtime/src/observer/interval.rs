@@ -8,7 +8,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::{IndexSet, Lcp};
-use crate::linalg::Cholesky;
+use crate::linalg::Ldlt;
 use crate::model::Model;
 
 use super::{ObserverError, ObserverParams, UpdateReport, check_update};
@@ -83,7 +83,7 @@ fn clearly_open<T: RealField + Copy>(h: T, row_norm_squared: T, band: T) -> bool
 ///   values a few ulps apart, and `l_d` is fixed per observer);
 /// * for a model whose `M` the compiler proved constant
 ///   ([`Structure::mass_constant`](crate::Structure::mass_constant)), `M`
-///   and its Cholesky factor, reused while `M` evaluates to the same bits
+///   and its `L D Lᵀ` factor, reused while `M` evaluates to the same bits
 ///   (a parameter changed through `parameter_mut` gives another `M`, and a
 ///   new factorization);
 /// * for a model whose `F` also depends on none of `t`, `q`, `v`, `u`,
@@ -93,7 +93,7 @@ fn clearly_open<T: RealField + Copy>(h: T, row_norm_squared: T, band: T) -> bool
 pub(crate) struct Cache<T: RealField + Copy, const N: usize> {
     gains: [(T, T); 4],
     next: usize,
-    mass: Option<(SMatrix<T, N, N>, Cholesky<T, N>)>,
+    mass: Option<(SMatrix<T, N, N>, Ldlt<T, N>)>,
     /// `(F, −M⁻¹F)` for the factor in `mass` (cleared with it).
     accel: Option<(SVector<T, N>, SVector<T, N>)>,
 }
@@ -134,7 +134,7 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
     /// it evaluates it, and reports a failure there) for any other model or
     /// when `M` does not factor.
     #[inline]
-    fn mass<M, const K: usize>(&mut self, model: &M, q: &SVector<T, N>) -> Option<Cholesky<T, N>>
+    fn mass<M, const K: usize>(&mut self, model: &M, q: &SVector<T, N>) -> Option<Ldlt<T, N>>
     where
         M: Model<N, K, Scalar = T>,
     {
@@ -165,7 +165,7 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
         u: &M::Input,
         t: T,
         q: &SVector<T, N>,
-        chol: Cholesky<T, N>,
+        chol: Ldlt<T, N>,
     ) -> Option<Free<T, N>>
     where
         M: Model<N, K, Scalar = T>,
@@ -208,7 +208,7 @@ pub(crate) fn check_contact<T: RealField + Copy, const N: usize, const K: usize>
 /// point of the predicted motion.
 #[derive(Clone, Copy)]
 pub(crate) struct Free<T: RealField + Copy, const N: usize> {
-    pub chol: Cholesky<T, N>,
+    pub chol: Ldlt<T, N>,
     pub accel: SVector<T, N>,
 }
 
@@ -230,7 +230,7 @@ struct Contact<'a, T: RealField + Copy, const N: usize, const K: usize> {
     s: T,
     w: &'a SVector<T, N>,
     jac: &'a SMatrix<T, K, N>,
-    chol: &'a Cholesky<T, N>,
+    chol: &'a Ldlt<T, N>,
 }
 
 /// The end of a piece of predicted motion, and the contact impulse
@@ -409,7 +409,7 @@ where
     pub noise_speed: T,
     /// The factor of `M` when the model's `M` is constant (the same at
     /// every point of the interval): one factorization, or none, per update.
-    pub mass: Option<Cholesky<T, N>>,
+    pub mass: Option<Ldlt<T, N>>,
     /// `M` factored and the free acceleration `−M⁻¹F`, the same at every
     /// point, for a model whose `M` is constant and whose `F` depends on
     /// none of `t`, `q`, `v`, `u` ([`Structure`](crate::Structure)): one
@@ -538,7 +538,7 @@ where
     pub fn impulse(
         &self,
         jac: &SMatrix<T, K, N>,
-        chol: &Cholesky<T, N>,
+        chol: &Ldlt<T, N>,
         w_free: &SVector<T, N>,
         approach: &SVector<T, K>,
         set: IndexSet<K>,
@@ -592,7 +592,7 @@ where
         t: T,
         p: &SVector<T, N>,
         w: &SVector<T, N>,
-    ) -> Result<(Cholesky<T, N>, SVector<T, N>), T> {
+    ) -> Result<(Ldlt<T, N>, SVector<T, N>), T> {
         if let Some(chol) = self.mass {
             let forces = self.model.forces(t, p, w, self.u);
             finite(&forces, "F")?;

@@ -143,7 +143,7 @@
 //!    leaves `v̂_e ∈ V(q_{k+1})`, as (20) asks.
 //!
 //! Cost, with no constraint near: four evaluations of `(M, F̄)` and
-//! Cholesky solves, three of `(h, J)`. An impact adds two Runge–Kutta legs
+//! `L D Lᵀ` solves, three of `(h, J)`. An impact adds two Runge–Kutta legs
 //! and a root search on `h`; a persistent contact, one small LCP per stage.
 //! Where the model's [`Structure`](crate::Structure) allows it, less: a
 //! constant `M` is factored once (a memo across updates), and with `F`

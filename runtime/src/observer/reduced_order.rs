@@ -384,7 +384,7 @@ where
 /// `0 ≤ λ ⊥ J(q_{k+1})(v̂_{k+1} + ê v̂_k) ≥ 0`, `v̂_{k+1} = v_free + M⁻¹Jᵀλ`.
 pub(crate) fn section_vii_impact<M, T, const N: usize, const K: usize>(
     interval: &Interval<'_, M, T, N, K>,
-    chol: &crate::linalg::Cholesky<T, N>,
+    chol: &crate::linalg::Ldlt<T, N>,
     v_before: &SVector<T, N>,
     v_free: &SVector<T, N>,
     report: &mut UpdateReport<T, N, K>,

@@ -129,7 +129,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::error::DataError;
 use crate::lcp::{IndexSet, Lcp};
-use crate::linalg::{Cholesky, Lu};
+use crate::linalg::{Ldlt, Lu};
 use crate::model::{Linearization, Model};
 use crate::state::State;
 use crate::validate;
@@ -674,24 +674,25 @@ const fn explicit_forces<M: Model<N, K>, const N: usize, const K: usize>() -> bo
 enum Factor<T: RealField + Copy, const N: usize> {
     /// `W = M` diagonal (the model's structure proves it, and that the
     /// forces depend on neither `q` nor `v`): its diagonal. A solve is one
-    /// division per coordinate, correctly rounded, where the Cholesky
-    /// route takes a square root and two divisions in a chain.
+    /// division per coordinate, correctly rounded (the `L D Lᵀ` route
+    /// divides the same way, after a factorization and two triangular
+    /// sweeps that only subtract zeros).
     Diagonal(SVector<T, N>),
-    /// `W = M` (forces that depend on neither `q` nor `v`): the Cholesky
+    /// `W = M` (forces that depend on neither `q` nor `v`): the `L D Lᵀ`
     /// factor the mass check already computed.
-    Mass(Cholesky<T, N>),
+    Mass(Ldlt<T, N>),
     /// The general, non-symmetric `W`.
     Lu(Lu<T, N>),
 }
 
-/// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored; `mass` is the Cholesky factor
+/// `W = M + τθ ∂F/∂v + τ²θ² ∂F/∂q`, factored; `mass` is the `L D Lᵀ` factor
 /// of `M`, reused when both Jacobians vanish. (Inlined: returned through
 /// memory from a call, its factor costs a store-forwarding stall at the
 /// first load.)
 #[inline(always)]
 fn iteration_matrix<T: RealField + Copy, const N: usize>(
     m: &SMatrix<T, N, N>,
-    mass: Cholesky<T, N>,
+    mass: Ldlt<T, N>,
     forces_dq: &SMatrix<T, N, N>,
     forces_dv: &SMatrix<T, N, N>,
     tau: T,
@@ -800,11 +801,11 @@ where
     Ok(())
 }
 
-/// Checks that `M` is positive definite and returns its Cholesky factor
+/// Checks that `M` is positive definite and returns its `L D Lᵀ` factor
 /// (the shared check, [`validate::factor_mass`]).
 fn check_mass<T: RealField + Copy, const N: usize>(
     m: &SMatrix<T, N, N>,
-) -> Result<Cholesky<T, N>, StepError<T>> {
+) -> Result<Ldlt<T, N>, StepError<T>> {
     Ok(validate::factor_mass(m)?)
 }
 

@@ -48,7 +48,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::IndexSet;
-use crate::linalg::Cholesky;
+use crate::linalg::Ldlt;
 use crate::model::Sensitivities;
 use crate::validate::{self, factor_mass};
 
@@ -152,7 +152,7 @@ fn white_noise<T: RealField + Copy, const N: usize>(d: &SMatrix<T, N, N>, h: T) 
 /// of the kinetic energy whose expected energy is that of `w`.
 fn energy_isotropic<T: RealField + Copy, const N: usize>(
     mass: &SMatrix<T, N, N>,
-    chol: &Cholesky<T, N>,
+    chol: &Ldlt<T, N>,
     w: &SVector<T, N>,
 ) -> SMatrix<T, N, N> {
     let scale = w.dot(&(mass * w)) / nalgebra::convert(N.max(1) as f64);
@@ -172,7 +172,7 @@ where
         piece: &Flight<'_, T, N, K>,
         held: IndexSet<K>,
         jac: &SMatrix<T, K, N>,
-        (mass, chol): (&SMatrix<T, N, N>, &Cholesky<T, N>),
+        (mass, chol): (&SMatrix<T, N, N>, &Ldlt<T, N>),
     ) -> SMatrix<T, N, N> {
         if self.contact == T::zero() || piece.h <= T::zero() {
             return SMatrix::zeros();

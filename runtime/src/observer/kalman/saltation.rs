@@ -8,7 +8,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::IndexSet;
-use crate::linalg::Cholesky;
+use crate::linalg::Ldlt;
 use crate::model::Sensitivities;
 
 use super::super::ObserverError;
@@ -162,7 +162,7 @@ where
             }
         }
         let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
-        let Some(w_chol) = Cholesky::new(&w) else {
+        let Some(w_chol) = Ldlt::new(&w) else {
             break;
         };
         let mut rhs = -(jac_a * free);
@@ -393,7 +393,7 @@ where
         }
     }
     let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
-    let w_chol = Cholesky::new(&w).ok_or(ObserverError::Data(DataError::InvalidParams {
+    let w_chol = Ldlt::new(&w).ok_or(ObserverError::Data(DataError::InvalidParams {
         name: "active",
         value: T::zero(),
     }))?;
@@ -490,7 +490,7 @@ pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K: usize>(
     p: &Blocks<T, N>,
-    mass: &Cholesky<T, N>,
+    mass: &Ldlt<T, N>,
     h: &SVector<T, K>,
     jac: &SMatrix<T, K, N>,
     rate: &SMatrix<T, K, N>,
@@ -514,7 +514,7 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
         }
     }
     let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
-    let w_chol = Cholesky::new(&w)?;
+    let w_chol = Ldlt::new(&w)?;
     // J⁺ = M⁻¹Jᵀ W⁻¹ (N × K)
     let pinv = w_chol.solve(&minv_jt.transpose()).transpose();
     let pi = SMatrix::<T, N, N>::identity() - pinv * j;
