@@ -544,9 +544,6 @@ fn horner(g: &mut Graph, terms: Vec<(f64, Vec<(Id, u32)>)>) -> Id {
 /// assert_eq!(shared[..4], [sa, ca, sb, cb]);
 /// ```
 pub fn share_waves(g: &mut Graph, roots: &[Id], first: &[Id]) -> Vec<Id> {
-    /// A combination at hand: its `sin`, its `cos`, and how many formulas
-    /// stand between it and a call.
-    type Hand = (Id, Id, u32);
     let size = |f: &Freq| {
         (
             f.iter().map(|&(_, k)| k.unsigned_abs()).sum::<u32>(),
@@ -598,6 +595,10 @@ pub fn share_waves(g: &mut Graph, roots: &[Id], first: &[Id]) -> Vec<Id> {
     g.replace(roots, &map)
 }
 
+/// A combination at hand in [`share_waves`]: its `sin`, its `cos`, and how
+/// many formulas stand between it and a call.
+type Hand = (Id, Id, u32);
+
 /// `freq` with its first coefficient positive, and whether it was negated;
 /// `None` for the empty combination.
 fn leading_positive(freq: Freq) -> Option<(Freq, bool)> {
@@ -611,11 +612,7 @@ fn leading_positive(freq: Freq) -> Option<(Freq, bool)> {
 
 /// `(sin, cos)` of `freq` from two combinations at hand whose sum or
 /// difference it is, the shallowest such pair; `None` if there is none.
-fn derive(
-    g: &mut Graph,
-    hand: &BTreeMap<Freq, (Id, Id, u32)>,
-    freq: &Freq,
-) -> Option<(Id, Id, u32)> {
+fn derive(g: &mut Graph, hand: &BTreeMap<Freq, Hand>, freq: &Freq) -> Option<Hand> {
     let mut best: Option<(u32, &Freq, Freq, bool)> = None;
     for (x, &(_, _, dx)) in hand {
         // freq = x + s·y with y at hand in canonical sign
