@@ -143,7 +143,9 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// filter takes every impact to be instantaneous and at the located
     /// time, and this is what it allows for a real one (a contact that
     /// lasts, a plant that meets the constraint on its own time grid). At
-    /// each impact it adds `σ_t² d dᵀ` to the covariance, with `d` the
+    /// each impact that a gap's root timed (not at a plastic closure or a
+    /// law met at a closed constraint, which have no instant) it adds
+    /// `σ_t² d dᵀ` to the covariance, with `d` the
     /// state's shift per unit of impact delay
     /// ([`Saltation::timing`](super::Saltation)): the velocity jump in
     /// position, the change of acceleration in velocity. Default `3e-6`
