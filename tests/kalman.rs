@@ -14,7 +14,7 @@ use moreau::{
 mod common;
 
 use common::runs::{
-    Gauss, Reference, example_1_run, example_1_starts, figures, measure, reference, score,
+    Gauss, Reference, Scored, example_1_run, example_1_starts, figures, measure, reference, score,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
@@ -45,6 +45,28 @@ where
         );
     }
     estimates
+}
+
+/// The window every Example 1 run here is scored over: `t ∈ [2, 10]` s.
+const WINDOW: (f64, f64) = (2.0, 10.0 + 1e-3);
+
+/// [`run`], then its figures over [`WINDOW`].
+fn scored<O, M, const N: usize, const K: usize>(
+    estimator: &mut O,
+    model: &M,
+    reference: &Reference<N>,
+    measured: &[SVector<f64, N>],
+    u: &M::Input,
+) -> Scored
+where
+    O: Observer<M, N, K>,
+    M: Model<N, K, Scalar = f64>,
+{
+    score(
+        reference,
+        &run(estimator, model, reference, measured, u),
+        WINDOW,
+    )
 }
 
 // ---------------------------------------------------------------------------
@@ -875,8 +897,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
             let mut f =
                 SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros())
                     .unwrap();
-            let est = run(&mut f, &model, &data, &measured, &u);
-            let sc = score(&data, &est, (2.0, 10.0 + 1e-3));
+            let sc = scored(&mut f, &model, &data, &measured, &u);
             let mut o = ReducedOrder::<f64, 2, 2>::new(
                 ObserverParams::new(10.0, 20.0).with_noise(sigma),
                 0.0,
@@ -884,8 +905,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                 Vector2::zeros(),
             )
             .unwrap();
-            let obs = run(&mut o, &model, &data, &measured, &u);
-            let so = score(&data, &obs, (2.0, 10.0 + 1e-3));
+            let so = scored(&mut o, &model, &data, &measured, &u);
             eprintln!(
                 "Example 1, start {n}, σ = {sigma:e}, knobs {label}: filter median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e}; samples to recover, worst {}), (38) median {:.2e} p90 {:.2e} max {:.2e}",
                 sc.all.median,
@@ -1000,8 +1020,7 @@ fn example_1_targets_hold_on_exact_event_driven_data() {
         let measured = measure(data, 1e-4, 5000 + n as u64);
         let mut f =
             SaltationKalman::<f64, 2, 2>::new(tuned, 0.0, measured[0], Vector2::zeros()).unwrap();
-        let est = run(&mut f, &model, data, &measured, &u);
-        let sc = score(data, &est, (2.0, 10.0 + 1e-3));
+        let sc = scored(&mut f, &model, data, &measured, &u);
         eprintln!(
             "exact run {n}, from ({:.2}, {:.2}) at ({:.2}, {:.2}), {} impacts: median {:.2e} p90 {:.2e} max {:.2e}, without the bracketing samples {:.2e}",
             q0[0],
@@ -1081,8 +1100,7 @@ fn example_1_targets_hold_on_a_plant_ten_times_finer() {
             Vector2::zeros(),
         )
         .unwrap();
-        let est = run(&mut f, &model, &data, &measured, &u);
-        let sc = score(&data, &est, (2.0, 10.0 + 1e-3));
+        let sc = scored(&mut f, &model, &data, &measured, &u);
         eprintln!(
             "Example 1, start {n}, plant at τ = 1e-6, σ = 1e-4, defaults: median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e})",
             sc.all.median, sc.all.p90, sc.all.max, sc.clean.max

@@ -319,12 +319,14 @@ where
             &e,
             guard,
         )?;
-        let noise = self.impact_noise(&s, guard.is_some(), jump.p, &w)?;
+        // a gap's root timed the impact: it has an instant, uncertain by
+        // σ_t and late on average by δ̄ (a closure the LCP makes at the
+        // start of a piece has neither)
+        let timed = guard.is_some();
+        let noise = self.impact_noise(&s, timed, jump.p, &w)?;
         self.p = s.matrix.congruence(&self.p).add(&noise).symmetrized();
         self.carry_offset(&s.matrix);
-        // the mean delay, for an impact that a gap's root timed (a closure
-        // the LCP makes at the start of a piece has no instant to delay)
-        if guard.is_some() && self.delay != T::zero() {
+        if timed && self.delay != T::zero() {
             self.offset.0 += s.timing.0 * self.delay;
             self.offset.1 += s.timing.1 * self.delay;
         }
