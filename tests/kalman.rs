@@ -14,7 +14,8 @@ use moreau::{
 mod common;
 
 use common::runs::{
-    Gauss, Reference, Scored, example_1_run, example_1_starts, figures, measure, reference, score,
+    Gauss, Reference, Scored, example_1_run, example_1_starts, figures, measure,
+    random_example_1_starts, reference, score,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2, Vector3};
@@ -942,6 +943,122 @@ fn example_1_figures_beside_the_reduced_order_observer() {
             }
         }
     }
+}
+
+/// Example 1 from 48 initial states drawn, not picked
+/// ([`random_example_1_starts`], seeds 555, 777, 999 and 1234, twelve
+/// each), run as the four starts above: plant at `τ = 1e-5`, 1 kHz, `σ =
+/// 1e-4` (noise seed `100 + n`), `v̂(0) = 0`, scored over `[2, 10]` s;
+/// the filter with its defaults beside (38) told `σ`, then the filter on
+/// the exact samples.
+///
+/// Asserted on every run: the filter's maximum off the samples that
+/// bracket a plant impact at most the issue's 1e-2, its median at most
+/// 1e-4 and its 90th percentile at most 4e-4 (the hand-written Python
+/// saltation filter the issue measured: median 5e-5 to 1e-4, 90th
+/// percentile 2e-4 to 7e-4), ten times below (38)'s median, and on the
+/// exact samples the issue's median of 1e-8; (38)'s median and 90th
+/// percentile within `1.4` and `3` × √2 l_d σ (as `tests/noise.rs`
+/// asserts on the four starts).
+///
+/// Printed, not asserted, because they do not hold on every draw (this
+/// test prints them; README "Under noise"): the filter's median ≤ 3e-5 and
+/// 90th percentile ≤ 2e-4 together hold on 13 of the 48 (median 1.2e-5
+/// to 7.3e-5, 90th percentile 8.5e-5 to 3.4e-4). A throw-away run of the
+/// same 48 against the plant at `τ = 1e-6`, with `σ_t` set to that
+/// plant's `τ/√12 = 0.29 µs`, met both on 38 of 48 (median up to 4.0e-5,
+/// 90th percentile up to 2.8e-4 on the others): most of the gap is the
+/// reference plant's own impact error (see
+/// `example_1_targets_hold_on_a_plant_ten_times_finer`), the rest is
+/// what the noise leaves unknown after fast impacts on the curved floor
+/// (a position known to 3e-5 m before the impact is a normal known to
+/// about 6e-5 rad, and a velocity after it uncertain by up to 1e-3 m/s
+/// there). (38)'s maximum off the bracketing samples is at most 0.1 on 45
+/// of the 48 (0.125, 0.143 and 0.196 on the other three). On seed 1234,
+/// starts 5 and 9, a slow approach (0.06 to 0.12 m/s, gaps at the noise
+/// level) was located two samples off, once late and once early, after
+/// several samples' noise had moved the smoothed position by several of
+/// its deviations, so a sample that no bracket excludes carries the whole
+/// jump. On seed 777, start 11, bounces 3 to 4 ms apart with peak gaps
+/// of 2e-4 to 3e-4 m (two to three σ) each leave 0.14 m/s on the two
+/// samples between them.
+#[test]
+fn example_1_random_starts_beside_the_reduced_order_observer() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let sigma = 1e-4;
+    let noise_scale = std::f64::consts::SQRT_2 * 10.0 * sigma;
+    let (mut met, mut met_38, mut runs) = (0, 0, 0);
+    for seed in [555, 777, 999, 1234] {
+        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
+            let data = reference(&model, start, 1e-5, 100, 10.0, &u);
+            let measured = measure(&data, sigma, 100 + n as u64);
+            let mut f = SaltationKalman::<f64, 2, 2>::new(
+                KalmanParams::new(20.0, sigma),
+                0.0,
+                measured[0],
+                Vector2::zeros(),
+            )
+            .unwrap();
+            let sc = scored(&mut f, &model, &data, &measured, &u);
+            let mut o = ReducedOrder::<f64, 2, 2>::new(
+                ObserverParams::new(10.0, 20.0).with_noise(sigma),
+                0.0,
+                measured[0],
+                Vector2::zeros(),
+            )
+            .unwrap();
+            let so = scored(&mut o, &model, &data, &measured, &u);
+            let exact = measure(&data, 0.0, 0);
+            let params = KalmanParams {
+                measurement: SMatrix::zeros(),
+                observer: ObserverParams {
+                    noise: 0.0,
+                    ..KalmanParams::<f64, 2>::new(20.0, sigma).observer
+                },
+                ..KalmanParams::new(20.0, sigma)
+            };
+            let mut f =
+                SaltationKalman::<f64, 2, 2>::new(params, 0.0, exact[0], Vector2::zeros()).unwrap();
+            let se = scored(&mut f, &model, &data, &exact, &u);
+            let issue = sc.all.median <= 3e-5 && sc.all.p90 <= 2e-4;
+            (runs, met, met_38) = (
+                runs + 1,
+                met + usize::from(issue),
+                met_38 + usize::from(so.clean.max <= 0.1),
+            );
+            eprintln!(
+                "seed {seed}, start {n} {start:?}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}{}, exact samples median {:.2e}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.3}",
+                sc.all.median,
+                sc.all.p90,
+                sc.clean.max,
+                if issue { "" } else { " (misses 3e-5 / 2e-4)" },
+                se.all.median,
+                so.all.median,
+                so.all.p90,
+                so.clean.max,
+            );
+            let at = format!("seed {seed}, start {n}");
+            assert!(sc.clean.max <= 1e-2, "{at}: {:e}", sc.clean.max);
+            assert!(
+                sc.all.median <= 1e-4 && sc.all.p90 <= 4e-4,
+                "{at}: median {:e}, p90 {:e}",
+                sc.all.median,
+                sc.all.p90
+            );
+            assert!(sc.all.median * 10.0 <= so.all.median, "{at}");
+            assert!(se.all.median <= 1e-8, "{at}: {:e}", se.all.median);
+            assert!(
+                so.all.median <= 1.4 * noise_scale && so.all.p90 <= 3.0 * noise_scale,
+                "{at}: (38) median {:e}, p90 {:e}",
+                so.all.median,
+                so.all.p90
+            );
+        }
+    }
+    eprintln!(
+        "the issue's median and 90th percentile met by the filter on {met} of {runs} runs; (38)'s maximum off the brackets at most 0.1 on {met_38} of {runs}"
+    );
 }
 
 /// An initial state `(q0, v0)` of Example 1.

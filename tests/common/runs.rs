@@ -233,3 +233,19 @@ pub fn example_1_starts() -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
         (Vector2::new(0.2, 1.0), Vector2::new(1.0, -2.0)),
     ]
 }
+
+/// `count` Example 1 initial states drawn with the seed `seed`, none
+/// picked: `x` uniform in [−1, 1], `y` uniform between 0.5 and 6.5 above
+/// the floor `y = x²` (at most 7.9, below the ceiling at 8), `v_x`
+/// uniform in [−4, 4] and `v_y` in [−5, 5] m/s.
+pub fn random_example_1_starts(seed: u64, count: usize) -> Vec<(SVector<f64, 2>, SVector<f64, 2>)> {
+    let mut g = Gauss::new(seed);
+    (0..count)
+        .map(|_| {
+            let x = 2.0 * g.uniform() - 1.0;
+            let y = (x * x + 0.5 + 6.0 * g.uniform()).min(7.9);
+            let v = Vector2::new(8.0 * g.uniform() - 4.0, 10.0 * g.uniform() - 5.0);
+            (Vector2::new(x, y), v)
+        })
+        .collect()
+}
