@@ -70,6 +70,16 @@ where
     )
 }
 
+/// The filter on Example 1 with its defaults for `σ`, from `v̂(0) = 0`,
+/// scored as [`scored`] scores it.
+fn with_defaults(reference: &Reference<2>, measured: &[Vector2<f64>], sigma: f64) -> Scored {
+    let params = KalmanParams::new(20.0, sigma);
+    let mut f =
+        SaltationKalman::<f64, 2, 2>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
+    let model = Parabola::<f64>::new();
+    scored(&mut f, &model, reference, measured, &SVector::zeros())
+}
+
 // ---------------------------------------------------------------------------
 // Saltation matrices against finite differences of flow–impact–flow
 
@@ -993,14 +1003,7 @@ fn example_1_random_starts_beside_the_reduced_order_observer() {
         for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
             let data = reference(&model, start, 1e-5, 100, 10.0, &u);
             let measured = measure(&data, sigma, 100 + n as u64);
-            let mut f = SaltationKalman::<f64, 2, 2>::new(
-                KalmanParams::new(20.0, sigma),
-                0.0,
-                measured[0],
-                Vector2::zeros(),
-            )
-            .unwrap();
-            let sc = scored(&mut f, &model, &data, &measured, &u);
+            let sc = with_defaults(&data, &measured, sigma);
             let mut o = ReducedOrder::<f64, 2, 2>::new(
                 ObserverParams::new(10.0, 20.0).with_noise(sigma),
                 0.0,
@@ -1210,14 +1213,7 @@ fn example_1_targets_hold_on_a_plant_ten_times_finer() {
     for (n, start) in example_1_starts().into_iter().enumerate() {
         let data = reference(&model, start, 1e-6, 1000, 10.0, &u);
         let measured = measure(&data, sigma, 11 + n as u64);
-        let mut f = SaltationKalman::<f64, 2, 2>::new(
-            KalmanParams::new(20.0, sigma),
-            0.0,
-            measured[0],
-            Vector2::zeros(),
-        )
-        .unwrap();
-        let sc = scored(&mut f, &model, &data, &measured, &u);
+        let sc = with_defaults(&data, &measured, sigma);
         eprintln!(
             "Example 1, start {n}, plant at τ = 1e-6, σ = 1e-4, defaults: median {:.2e} p90 {:.2e} max {:.2e} (without the bracketing samples: max {:.2e})",
             sc.all.median, sc.all.p90, sc.all.max, sc.clean.max
