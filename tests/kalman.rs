@@ -991,7 +991,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
 /// level) was located two samples off, once late and once early, after
 /// several samples' noise had moved the smoothed position by several of
 /// its deviations, so a sample that no bracket excludes carries the whole
-/// jump. On seed 777, start 11, bounces 4 to 5 ms apart with peak gaps
+/// jump. On seed 777, start 11, bounces about 4 ms apart (3.7 to 4.8) with peak gaps
 /// of 2e-4 to 3e-4 m (two to three σ) each leave 0.14 m/s on the two
 /// samples between them.
 #[test]
