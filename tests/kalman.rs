@@ -89,6 +89,20 @@ fn reduced_order(reference: &Reference<2>, measured: &[Vector2<f64>], sigma: f64
     scored(&mut o, &model, reference, measured, &SVector::zeros())
 }
 
+/// The filter's figures `filter` within the range of the hand-written
+/// Python saltation filter the issue measured (median ≤ 1e-4, 90th
+/// percentile ≤ 4e-4) and its median ten times below that of (38),
+/// `observer`, on the same samples; `at` names the run.
+fn assert_beside_python_and_38(filter: &Scored, observer: &Scored, at: &str) {
+    assert!(
+        filter.all.median <= 1e-4 && filter.all.p90 <= 4e-4,
+        "{at}: median {:e}, p90 {:e}",
+        filter.all.median,
+        filter.all.p90
+    );
+    assert!(filter.all.median * 10.0 <= observer.all.median, "{at}");
+}
+
 // ---------------------------------------------------------------------------
 // Saltation matrices against finite differences of flow–impact–flow
 
@@ -941,13 +955,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
                     sc.all.median
                 );
             } else {
-                assert!(
-                    sc.all.median <= 1e-4 && sc.all.p90 <= 4e-4,
-                    "start {n}, {label}: median {:e}, p90 {:e}",
-                    sc.all.median,
-                    sc.all.p90
-                );
-                assert!(sc.all.median * 10.0 <= so.all.median, "start {n}, {label}");
+                assert_beside_python_and_38(&sc, &so, &format!("start {n}, {label}"));
                 if label == "defaults" {
                     assert!(sc.all.median <= 5e-5, "start {n}: {:e}", sc.all.median);
                     assert!(sc.clean.max <= 1e-2, "start {n}: {:e}", sc.clean.max);
@@ -1030,13 +1038,7 @@ fn example_1_random_starts_beside_the_reduced_order_observer() {
             );
             let at = format!("seed {seed}, start {n}");
             assert!(sc.clean.max <= 1e-2, "{at}: {:e}", sc.clean.max);
-            assert!(
-                sc.all.median <= 1e-4 && sc.all.p90 <= 4e-4,
-                "{at}: median {:e}, p90 {:e}",
-                sc.all.median,
-                sc.all.p90
-            );
-            assert!(sc.all.median * 10.0 <= so.all.median, "{at}");
+            assert_beside_python_and_38(&sc, &so, &at);
             assert!(se.all.median <= 1e-8, "{at}: {:e}", se.all.median);
             assert!(
                 so.all.median <= 1.4 * noise_scale && so.all.p90 <= 3.0 * noise_scale,
