@@ -195,7 +195,27 @@
 //!   the whole interval instead of losing `A_i τ` of it): under noise a
 //!   rebound of a few tenths of a m/s in an accumulation flies and
 //!   decelerates instead of keeping its speed for an interval. With
-//!   `σ = 0` and `d = 0` the rule is the same.
+//!   `σ = 0` and `d = 0` the rule is the same;
+//! - a closed constraint still open (`h_i > 0`) and approached, that its
+//!   normal acceleration `α_i = J_i a + J̇_i w > 0` turns back before the
+//!   gap is more than the band deep (`h_i − (J_i w)²/(2α_i) ≥ −g_i b`), under
+//!   the free motion and, beside other closed constraints, with them held
+//!   and itself taking no force, is **grazed**: neither hit nor closed, held
+//!   at acceleration level (where it gets no force).
+//!
+//! Newton's law on several constraints at once is checked twice. With
+//! unequal restitutions it can put energy in; when it does, Moreau's law
+//! with the least restitution of the set replaces it (the plastic
+//! projection `w_p`, then `w⁺ = w_p + e (w_p − w⁻)`, which never gains
+//! energy). And where the gradients are nearly opposite, the closure of
+//! the thin wedge between them takes far more energy than the normal
+//! speeds carry (more than four times what each constraint would take
+//! alone); the constraints are then met one at a time, the fastest
+//! approach first, as alternating bounces meet them (and so too where the
+//! impact problem has no solution in floating point). Both come from the
+//! double pendulum, whose tip reaches the corner of wall and floor only at
+//! the arm's full reach (`tests/kalman.rs`,
+//! `the_double_pendulum_passes_the_corner_at_its_full_reach`).
 //!
 //! Along each piece of prediction: an open gap that ends closed has a root
 //! in between; an open gap that starts closing and ends opening is
