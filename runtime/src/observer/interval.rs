@@ -1005,9 +1005,8 @@ where
     }
 
     /// The closed constraints (`closed`, less those just `touched` by a
-    /// root) that the motion grazes: each
-    /// approached (`J_i w < 0`) but turned back before its gap is more
-    /// than the band deep ([`turns_within_band`]) by its normal
+    /// root) that the motion grazes: each approached (`J_i w < 0`) but
+    /// turned back before its gap is more than the band deep ([`turns_within_band`]) by its normal
     /// acceleration, first under the free motion and then, where other
     /// constraints are closed, under the motion with all of them held at
     /// acceleration level, in which it must take no force. (A ball wedged
@@ -1036,7 +1035,11 @@ where
             return Ok(grazed);
         }
         let mut scratch = UpdateReport::new(self.t0, self.tau);
-        let (held, lambda) = self.constrained(at.p, at.w, closed, at.free, &mut scratch)?;
+        let Ok((held, lambda)) = self.constrained(at.p, at.w, closed, at.free, &mut scratch) else {
+            // no held motion to check against (a contact problem without
+            // a solution): none is taken for grazed
+            return Ok(IndexSet::EMPTY);
+        };
         for i in grazed {
             if lambda[i] > T::zero() || !turns(i, &held) {
                 grazed.remove(i);
