@@ -10,8 +10,11 @@
 //!    can move is refused ([`ObserverError::Outlier`]), the filter
 //!    untouched; a run of such samples that agree with each other, an
 //!    interval longer than [`ObserverParams::max_interval`] (3 s with
-//!    [`KalmanParams::new`]), or a prediction that fails from the filter's
-//!    own state restarts it from the measurement with the observers'
+//!    [`KalmanParams::new`]), a prediction that fails from the filter's
+//!    own state, or a covariance whose innovation covariance no longer
+//!    factors (not positive definite by more than rounding; seen on exact
+//!    samples with a generous `C_v`, `tests/kalman.rs`) restarts it from
+//!    the measurement with the observers'
 //!    restart velocity and a fresh covariance ([`UpdateReport::restart`]).
 //!    Every estimate is held to the velocity bound `C_v`, as theirs are.
 //! 1. **Predict** the state `x = (q, v)` from the estimate `(q̂_k, v̂_k)`
@@ -743,17 +746,35 @@ where
         let eps = T::default_epsilon();
         let scale = q.amax().max(T::one());
         let floor = eps * scale * scale + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax();
-        let (mut r, mut chol) = innovation_factor(&p.qq, &self.params.measurement, floor)?;
-        let mut nis = y.dot(&chol.solve(&y));
         let mut outliers = self.outliers;
         let gate = self.params.gate;
-        if nis > gate && self.outliers >= self.params.max_outliers {
-            // the model, not the sample, is wrong: widen the prediction
-            p = p.scaled(nis / nalgebra::convert(N.max(1) as f64));
-            kalman.inflated = true;
-            (r, chol) = innovation_factor(&p.qq, &self.params.measurement, floor)?;
-            nis = y.dot(&chol.solve(&y));
-        }
+        let factored = innovation_factor(&p.qq, &self.params.measurement, floor)
+            .ok()
+            .and_then(|(r, chol)| {
+                let nis = y.dot(&chol.solve(&y));
+                if nis > gate && self.outliers >= self.params.max_outliers {
+                    // the model, not the sample, is wrong: widen the
+                    // prediction
+                    p = p.scaled(nis / nalgebra::convert(N.max(1) as f64));
+                    kalman.inflated = true;
+                    let (r, chol) =
+                        innovation_factor(&p.qq, &self.params.measurement, floor).ok()?;
+                    Some((r, chol, y.dot(&chol.solve(&y))))
+                } else {
+                    Some((r, chol, nis))
+                }
+            });
+        let Some((r, chol, nis)) = factored else {
+            // a covariance that is not positive definite by more than
+            // rounding: the filter's own state failed, and it starts again
+            // from the measurement, as after a failed prediction (refusing
+            // the sample would keep that state, and refuse every sample
+            // after it)
+            let mut report = fresh;
+            let v = restart_velocity(&interval, &self.v, Restart::Infeasible, &mut report)?;
+            let end = (interval.t0 + interval.tau, interval.q1);
+            return Ok(self.restarted(end.0, end.1, v, report));
+        };
         kalman.nis = nis;
         kalman.log_det = chol
             .l()
