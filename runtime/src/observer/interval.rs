@@ -74,11 +74,20 @@ fn clearly_open<T: RealField + Copy>(h: T, row_norm_squared: T, band: T) -> bool
     h > T::zero() && h * h > four * row_norm_squared * band * band
 }
 
-/// Whether Newton's law put kinetic energy in: the impulses `λ` took the
-/// normal velocities `J w⁻ = jw_minus` to `J w⁺ = jw_plus`, and the change
-/// of `½ wᵀ M w` is `½ λᵀ (J w⁺ + J w⁻)` (since `M (w⁺ − w⁻) = Jᵀ λ`; no
-/// `M` needed), here compared with `√ε` times its dissipation scale
-/// `Σ λ_i |J_i w⁻|`, far above rounding.
+/// The change of the kinetic energy `½ wᵀ M w` when the impulses `λ`
+/// took the normal velocities `J w⁻ = jw_minus` to `J w⁺ = jw_plus`: `½
+/// λᵀ (J w⁺ + J w⁻)` (since `M (w⁺ − w⁻) = Jᵀ λ`; no `M` needed).
+fn energy_change<T: RealField + Copy, const K: usize>(
+    lambda: &SVector<T, K>,
+    jw_minus: &SVector<T, K>,
+    jw_plus: &SVector<T, K>,
+) -> T {
+    nalgebra::convert::<f64, T>(0.5) * lambda.dot(&(jw_plus + jw_minus))
+}
+
+/// Whether Newton's law put kinetic energy in ([`energy_change`]): more
+/// than `√ε` times its dissipation scale `½ Σ λ_i |J_i w⁻|`, far above
+/// rounding.
 ///
 /// Newton's law `J_i w⁺ = −e_i J_i w⁻` on one constraint, or with one `e`
 /// on several (then it is Moreau's law, `w⁺ = w_p + e (w_p − w⁻)` with
@@ -88,17 +97,16 @@ fn clearly_open<T: RealField + Copy>(h: T, row_norm_squared: T, band: T) -> bool
 /// impulse to hold the rebound of another, and where their gradients are
 /// nearly opposite (the double pendulum's tip in the corner at its full
 /// reach) the impulses grow like the inverse of the angle between them
-/// and the estimate gained 35 times its kinetic energy, along the
-/// direction the two constraints do not see (−8.6 and 8.5 rad/s from
-/// 1.4 and −1.2).
+/// and (38)'s estimate went from (1.4, −1.2) to (−8.6, 8.5) rad/s, about
+/// 35 times its kinetic energy (`M` taken at the stretched arm), along
+/// the direction the two constraints do not see.
 fn gains_energy<T: RealField + Copy, const K: usize>(
     lambda: &SVector<T, K>,
     jw_minus: &SVector<T, K>,
     jw_plus: &SVector<T, K>,
 ) -> bool {
-    let change = lambda.dot(&(jw_plus + jw_minus));
-    let scale = lambda.dot(&jw_minus.abs());
-    change > T::default_epsilon().sqrt() * scale
+    let scale = nalgebra::convert::<f64, T>(0.5) * lambda.dot(&jw_minus.abs());
+    energy_change(lambda, jw_minus, jw_plus) > T::default_epsilon().sqrt() * scale
 }
 
 /// Whether the impulses `λ` of a closure on several constraints took far
@@ -129,7 +137,7 @@ fn opposed<T: RealField + Copy, const K: usize>(
 ) -> bool {
     let half: T = nalgebra::convert(0.5);
     let four: T = nalgebra::convert(4.0);
-    let taken = -half * lambda.dot(&(jw_plus + jw_minus));
+    let taken = -energy_change(lambda, jw_minus, jw_plus);
     let mut carried = T::zero();
     for i in set {
         let jw = jw_minus[i].min(T::zero());
@@ -602,45 +610,23 @@ where
     ) -> Result<SVector<T, N>, T> {
         let Contact { s, w, jac, chol } = *at;
         let jw = jac * w;
-        let mut approach = SVector::<T, K>::zeros();
+        // the restitution each constraint of the set takes: `ê_i` if elastic
+        let mut e = SVector::<T, K>::zeros();
         for i in elastic {
-            approach[i] = self.restitution[i] * jw[i];
+            e[i] = self.restitution[i];
         }
         let before = report.impulses;
-        let mut dv = match self.impulse(jac, chol, w, &approach, set, report) {
+        let dv = match self.impulse(jac, chol, w, &e.component_mul(&jw), set, report) {
+            Ok(dv) if set.len() > 1 => self.checked(at, (set, &e, &jw), before, dv, report)?,
             Ok(dv) => dv,
             // gradients nearly dependent (see `opposed`) can leave the
             // problem without a solution in floating point
             Err(_) if set.len() > 1 => {
                 let minv_jt = chol.solve(&jac.transpose());
-                self.one_at_a_time(at, &minv_jt, set, elastic, report)
+                self.one_at_a_time(at, &minv_jt, set, &e, report)
             }
             Err(e) => return Err(e),
         };
-        if gains_energy(&(report.impulses - before), &jw, &(jac * (w + dv))) {
-            // Moreau's law with one restitution, the least of the set's:
-            // `w⁺ = w_p + e (w_p − w)`, `w_p` the plastic projection
-            let least = set.iter().fold(T::one(), |e, i| {
-                e.min(if elastic.contains(i) {
-                    self.restitution[i]
-                } else {
-                    T::zero()
-                })
-            });
-            report.impulses = before;
-            let plastic = self.impulse(jac, chol, w, &SVector::zeros(), set, report)?;
-            let scale = T::one() + least;
-            report.impulses = before + (report.impulses - before) * scale;
-            dv = plastic * scale;
-        }
-        if set.len() > 1 {
-            let minv_jt = chol.solve(&jac.transpose());
-            let lambda = report.impulses - before;
-            if opposed(set, &lambda, &jw, &(jac * (w + dv)), &(jac * minv_jt)) {
-                report.impulses = before;
-                dv = self.one_at_a_time(at, &minv_jt, set, elastic, report);
-            }
-        }
         // an impact when an elastic (fast) approach received an impulse; a
         // plastic closure of a resting contact is a contact
         if elastic.iter().any(|i| report.impulses[i] > before[i]) {
@@ -654,35 +640,63 @@ where
         Ok(w + dv)
     }
 
-    /// Newton's law on the constraints of `set` one at a time, the
-    /// fastest approach first, each once, on the velocity the ones before
-    /// left (see [`opposed`]): returns `w⁺ − w` and records the impulses.
+    /// Newton's law on several constraints (`set`, restitutions `e`,
+    /// normal speeds `jw = J w⁻`), its solution `dv = w⁺ − w` checked: where it put energy in
+    /// ([`gains_energy`]), Moreau's law with the least restitution of the
+    /// set, `w⁺ = w_p + e (w_p − w)` with `w_p` the plastic projection,
+    /// takes its place; where the closure is of nearly opposite
+    /// constraints ([`opposed`]), the constraints are met one at a time
+    /// ([`one_at_a_time`](Self::one_at_a_time)). The impulses recorded
+    /// since `before` are those of the law kept.
+    fn checked(
+        &self,
+        at: &Contact<'_, T, N, K>,
+        (set, e, jw): (IndexSet<K>, &SVector<T, K>, &SVector<T, K>),
+        before: SVector<T, K>,
+        mut dv: SVector<T, N>,
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<SVector<T, N>, T> {
+        let Contact { w, jac, chol, .. } = *at;
+        if gains_energy(&(report.impulses - before), jw, &(jac * (w + dv))) {
+            let least = set.iter().fold(T::one(), |least, i| least.min(e[i]));
+            report.impulses = before;
+            let plastic = self.impulse(jac, chol, w, &SVector::zeros(), set, report)?;
+            let scale = T::one() + least;
+            report.impulses = before + (report.impulses - before) * scale;
+            dv = plastic * scale;
+        }
+        let minv_jt = chol.solve(&jac.transpose());
+        let lambda = report.impulses - before;
+        if opposed(set, &lambda, jw, &(jac * (w + dv)), &(jac * minv_jt)) {
+            report.impulses = before;
+            dv = self.one_at_a_time(at, &minv_jt, set, e, report);
+        }
+        Ok(dv)
+    }
+
+    /// Newton's law on the constraints of `set` (restitutions `e`) one at
+    /// a time, the fastest approach first, each once, on the velocity the
+    /// ones before left (see [`opposed`]): returns `w⁺ − w` and records the
+    /// impulses.
     fn one_at_a_time(
         &self,
         at: &Contact<'_, T, N, K>,
         minv_jt: &SMatrix<T, N, K>,
         set: IndexSet<K>,
-        elastic: IndexSet<K>,
+        e: &SVector<T, K>,
         report: &mut UpdateReport<T, N, K>,
     ) -> SVector<T, N> {
         let mut dv = SVector::<T, N>::zeros();
         let mut left = set;
-        while let Some(i) = left
+        while let Some((i, jw)) = left
             .iter()
             .map(|i| (i, at.jac.row(i).dot(&(at.w + dv).transpose())))
             .filter(|&(_, jw)| jw < T::zero())
             .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
-            .map(|(i, _)| i)
         {
             left.remove(i);
-            let jw = at.jac.row(i).dot(&(at.w + dv).transpose());
-            let e = if elastic.contains(i) {
-                self.restitution[i]
-            } else {
-                T::zero()
-            };
             let delassus = at.jac.row(i).dot(&minv_jt.column(i).transpose());
-            let lambda = -(T::one() + e) * jw / delassus;
+            let lambda = -(T::one() + e[i]) * jw / delassus;
             if lambda > T::zero() && lambda.is_finite() {
                 dv += minv_jt.column(i) * lambda;
                 report.impulses[i] += lambda;
@@ -952,12 +966,19 @@ where
             return Ok(c);
         }
         let rate = self.jacobian_rate(p, w)?;
-        let grazed = self.grazed(at, (h, jac), &rate, (closed, touched))?;
+        // the closed constraints' normal speeds `J_i w` and signed normal
+        // accelerations `J_i a + J̇_i w` of the free motion
+        let (mut speed, mut alpha) = (SVector::<T, K>::zeros(), SVector::<T, K>::zeros());
+        for i in closed {
+            speed[i] = jac.row(i).dot(&w.transpose());
+            alpha[i] = jac.row(i).dot(&accel.transpose()) + rate[i];
+        }
+        let grazed = self.grazed(at, (h, jac, &rate), (&speed, &alpha), (closed, touched))?;
         for i in closed {
             let row = jac.row(i);
             let g = row.norm();
-            let jw = row.dot(&w.transpose());
-            let normal_accel = (row.dot(&accel.transpose()) + rate[i]).abs();
+            let jw = speed[i];
+            let normal_accel = alpha[i].abs();
             if grazed.contains(i) {
                 // no impact and no closure: held at acceleration level,
                 // where the law gives it no force
@@ -1005,9 +1026,10 @@ where
     }
 
     /// The closed constraints (`closed`, less those just `touched` by a
-    /// root) that the motion grazes: each approached (`J_i w < 0`) but
-    /// turned back before its gap is more than the band deep ([`turns_within_band`]) by its normal
-    /// acceleration, first under the free motion and then, where other
+    /// root) that the motion grazes: each approached (`J_i w < 0`, its
+    /// `speed`) but turned back before its gap is more than the band deep
+    /// ([`turns_within_band`]) by its normal acceleration, first under the
+    /// free motion (`alpha`, with the rates `J̇_i w`) and then, where other
     /// constraints are closed, under the motion with all of them held at
     /// acceleration level, in which it must take no force. (A ball wedged
     /// in a cusp under gravity is pulled away from one wall by the free
@@ -1015,19 +1037,16 @@ where
     fn grazed(
         &self,
         at: &Point<'_, T, N>,
-        (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
-        rate: &SVector<T, K>,
+        (h, jac, rate): (&SVector<T, K>, &SMatrix<T, K, N>, &SVector<T, K>),
+        (speed, alpha): (&SVector<T, K>, &SVector<T, K>),
         (closed, touched): (IndexSet<K>, IndexSet<K>),
     ) -> Result<IndexSet<K>, T> {
         let band = self.params.contact_band();
-        let turns = |i: usize, a: &SVector<T, N>| {
-            let row = jac.row(i);
-            let alpha = row.dot(&a.transpose()) + rate[i];
-            turns_within_band(h[i], row.dot(&at.w.transpose()), alpha, row.norm() * band)
-        };
+        let turns =
+            |i: usize, alpha: T| turns_within_band(h[i], speed[i], alpha, jac.row(i).norm() * band);
         let mut grazed = IndexSet::EMPTY;
         for i in closed.difference(touched) {
-            if turns(i, &at.free.accel) {
+            if turns(i, alpha[i]) {
                 grazed.insert(i);
             }
         }
@@ -1041,7 +1060,7 @@ where
             return Ok(IndexSet::EMPTY);
         };
         for i in grazed {
-            if lambda[i] > T::zero() || !turns(i, &held) {
+            if lambda[i] > T::zero() || !turns(i, jac.row(i).dot(&held.transpose()) + rate[i]) {
                 grazed.remove(i);
             }
         }

@@ -84,7 +84,7 @@ pub use tune::{NoiseFactors, Tuning, tune_process_noise};
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::Lcp;
-use crate::model::Sensitivities;
+use crate::model::{Model, Sensitivities};
 
 use super::interval::{Cache, Interval, Memory, saturate};
 use super::reduced_order::restart_velocity;
@@ -721,10 +721,7 @@ where
             // from the filter's own state: start again from the
             // measurement, as the observers do
             Err(why) => {
-                let mut report = fresh;
-                let v = restart_velocity(&interval, &self.v, why, &mut report)?;
-                let end = (interval.t0 + interval.tau, interval.q1);
-                return Ok(self.restarted(end.0, end.1, v, report));
+                return Ok(self.restarted(restart_point(&interval, &self.v, why, fresh)?));
             }
         };
         let (q_pred, v_pred) = (
@@ -770,10 +767,8 @@ where
             // from the measurement, as after a failed prediction (refusing
             // the sample would keep that state, and refuse every sample
             // after it)
-            let mut report = fresh;
-            let v = restart_velocity(&interval, &self.v, Restart::Infeasible, &mut report)?;
-            let end = (interval.t0 + interval.tau, interval.q1);
-            return Ok(self.restarted(end.0, end.1, v, report));
+            let point = restart_point(&interval, &self.v, Restart::Infeasible, fresh)?;
+            return Ok(self.restarted(point));
         };
         kalman.nis = nis;
         kalman.log_det = chol
@@ -823,20 +818,35 @@ where
     }
 }
 
+/// Where a restart puts the filter: the time and the measurement at the
+/// end of the interval, the velocity and the report that records why.
+type RestartPoint<T, const N: usize, const K: usize> =
+    (T, SVector<T, N>, SVector<T, N>, UpdateReport<T, N, K>);
+
+/// The restart at the end of `interval` for `why`, from the report `fresh`
+/// of the interval's start: the observers' restart velocity (`v̂_k` kept
+/// after a run of outliers, else the mean velocity over the interval, held
+/// to `C_v` and closed at the measurement).
+fn restart_point<M, T, const N: usize, const K: usize>(
+    interval: &Interval<'_, M, T, N, K>,
+    v_k: &SVector<T, N>,
+    why: Restart,
+    mut report: UpdateReport<T, N, K>,
+) -> Result<RestartPoint<T, N, K>, T>
+where
+    T: RealField + Copy,
+    M: Model<N, K, Scalar = T>,
+{
+    let v = restart_velocity(interval, v_k, why, &mut report)?;
+    Ok((interval.t0 + interval.tau, interval.q1, v, report))
+}
+
 impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
-    /// The filter started again at `(t, q)` with the velocity `v` (the
-    /// observers' restart velocity, [`Restart`]: `v̂_k` kept after a run of
-    /// outliers, else the mean velocity over the interval, held to `C_v`
-    /// and closed at the measurement) and the covariance of a fresh filter
-    /// (`R` on the position, [`KalmanParams::initial_velocity_sigma`]`²`
-    /// on the velocity); `report` records why.
-    fn restarted(
-        &mut self,
-        t: T,
-        q: SVector<T, N>,
-        v: SVector<T, N>,
-        mut report: UpdateReport<T, N, K>,
-    ) -> Estimate<T, N> {
+    /// The filter started again at `(t, q)` with the velocity `v`
+    /// ([`restart_point`]) and the covariance of a fresh filter (`R` on the
+    /// position, [`KalmanParams::initial_velocity_sigma`]`²` on the
+    /// velocity); `report` records why.
+    fn restarted(&mut self, (t, q, v, mut report): RestartPoint<T, N, K>) -> Estimate<T, N> {
         let s = self.params.initial_velocity_sigma;
         let p = Blocks::diagonal(self.params.measurement, SMatrix::identity() * (s * s));
         report.outliers = self.screen.accept();
