@@ -12,10 +12,11 @@
 //!    interval longer than [`ObserverParams::max_interval`] (3 s with
 //!    [`KalmanParams::new`]), a prediction that fails from the filter's
 //!    own state, or a covariance whose innovation covariance no longer
-//!    factors (not positive definite by more than rounding; seen on exact
-//!    samples with a generous `C_v`, `tests/kalman.rs`) restarts it from
-//!    the measurement with the observers'
-//!    restart velocity and a fresh covariance ([`UpdateReport::restart`]).
+//!    factors (not positive definite by more than rounding) restarts it
+//!    from the measurement with the observers' restart velocity (the mean
+//!    velocity since the last sample used, not since the estimate, which
+//!    may be what failed) and a fresh covariance
+//!    ([`UpdateReport::restart`]).
 //!    Every estimate is held to the velocity bound `C_v`, as theirs are.
 //! 1. **Predict** the state `x = (q, v)` from the estimate `(q̂_k, v̂_k)`
 //!    through the observers' interval: fourth-order Runge–Kutta on the
@@ -59,6 +60,26 @@
 //!      is the noise's position and velocity variances, added
 //!      uncorrelated: `P` stays positive definite, and a penetration seen
 //!      in exact samples moves the position estimate, not the velocity.
+//!
+//!    **Relinearised** on the first update after a start or a restart. Its
+//!    prior velocity is a guess (`v̂(0)`, or a restart's mean velocity)
+//!    with a variance of `C_v²`, and a prediction linearised there can be
+//!    far off where the forces are nonlinear in `v`: on exact samples of
+//!    the three-link arm, `v̂(0) = 0` missed the Coriolis forces, the first
+//!    update claimed a velocity known to 3e-5 rad/s that was 9e-3 off, and
+//!    the filter then refused or restarted for 250 ms (`tests/kalman.rs`).
+//!    So that update is an iterated extended Kalman update (Gauss–Newton
+//!    on the state at `t_k`): with `Φ P_k` carried along the prediction
+//!    ([`Propagation`]), the start the sample implies is
+//!    `x_lin = x̂_k + P_k Φᵀ Hᵀ S⁻¹ (q_{k+1} − m)`, `m = φ(x_lin) + Φ (x̂_k −
+//!    x_lin)` the prediction linearised at the last such point, and the
+//!    interval is predicted again from it until the velocity moves by less
+//!    than `√ε (1 + |v|)` (at most four times; a prediction that fails
+//!    keeps the last). The update then uses the last `m`, `Φ` and `P`. The
+//!    impacts of the interval are located again from each point, so a
+//!    guess that missed one does not decide. Every later update is the
+//!    plain extended one (its prior is the filter's own, and one
+//!    prediction per update is what it costs).
 //! 2. **Gate** the innovation `y = q_{k+1} − p(τ)`, `S = P_qq + R`: a
 //!    normalised innovation squared `yᵀS⁻¹y` above
 //!    [`KalmanParams::gate`] marks the sample an outlier; it is reported
@@ -396,6 +417,9 @@ pub struct KalmanReport<T> {
     pub saltations: u32,
     /// Projections of the covariance onto a contact manifold.
     pub projections: u32,
+    /// Predictions made again at a new linearisation point (only the
+    /// first update after a start or a restart: module docs, step 1, "Relinearised").
+    pub relinearisations: u32,
 }
 
 impl<T: RealField + Copy> KalmanReport<T> {
@@ -407,6 +431,7 @@ impl<T: RealField + Copy> KalmanReport<T> {
             inflated: false,
             saltations: 0,
             projections: 0,
+            relinearisations: 0,
         }
     }
 
@@ -417,7 +442,7 @@ impl<T: RealField + Copy> KalmanReport<T> {
     /// use moreau_runtime::KalmanReport;
     ///
     /// let r = KalmanReport { nis: 0.0, log_det: 0.0, outlier: false, inflated: false,
-    ///                        saltations: 0, projections: 0 };
+    ///                        saltations: 0, projections: 0, relinearisations: 0 };
     /// let expected = -0.5 * (2.0 * std::f64::consts::PI).ln();
     /// assert!((r.log_likelihood(1) - expected).abs() < 1e-15);
     /// ```
@@ -505,6 +530,11 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     kalman: KalmanReport<T>,
     /// The observers' memos (injection gain, a constant `M`'s factor).
     cache: Cache<T, N>,
+    /// The last sample used (a restart's velocity starts from it).
+    sample: SVector<T, N>,
+    /// Whether the next update is the first since a start or a restart
+    /// (and relinearises: module docs, step 1, "Relinearised").
+    fresh: bool,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
@@ -578,6 +608,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             report: UpdateReport::new(t0, T::zero()),
             kalman: KalmanReport::empty(),
             cache: Cache::default(),
+            sample: q0,
+            fresh: true,
         })
     }
 
@@ -693,7 +725,7 @@ where
         // can move is refused here, the estimate untouched; a run of such
         // samples that agree with each other, or an interval longer than
         // `max_interval`, restarts the filter from the measurement
-        let fresh = report;
+        let opened = report;
         let plan = self
             .screen
             .screen(&self.params.observer, (t, interval.tau), &self.q, q)?;
@@ -707,31 +739,75 @@ where
         // no injection: the filter's correction is its Kalman gain
         report.gain = T::zero();
         // PREDICT, the covariance following every piece and impact
-        let mut propagation = Propagation::new(model, u, self.t, &self.params, self.p);
+        // (the restart's velocity from the last sample used, not from an
+        // estimate that may be what failed)
+        let last = Interval {
+            q0: self.sample,
+            ..interval
+        };
         let v0 = saturate(&self.v, self.params.observer.velocity_bound);
+        let mut linearised = (self.q, v0);
+        let unpredicted = report;
         let predicted = match plan {
-            Plan::Integrate => interval
-                .predict_traced(&v0, &mut report, &mut propagation)
+            Plan::Integrate => self
+                .predict(&interval, &v0, linearised, &mut report)
                 .map_err(|_| Restart::Infeasible),
             Plan::Restart(why) => Err(why),
         };
-        let (q_pred, v_pred) = match predicted {
+        let (mut q_pred, mut v_pred, mut propagation) = match predicted {
             Ok(end) => end,
             // agreeing outliers, a long gap, or a prediction that failed
             // from the filter's own state: start again from the
             // measurement, as the observers do
             Err(why) => {
-                return Ok(self.restarted(restart_point(&interval, &self.v, why, fresh)?));
+                return Ok(self.restarted(restart_point(&last, &self.v, why, opened)?));
             }
         };
-        let (q_pred, v_pred) = (
-            q_pred + propagation.correction.0 + propagation.offset.0,
-            v_pred + propagation.correction.1 + propagation.offset.1,
-        );
+        // RELINEARISE the first update after a start or a restart, whose
+        // prior velocity is a guess (module docs, step 1, "Relinearised")
+        let measurement = self.params.measurement;
+        let floor = |p: &Blocks<T, N>| {
+            let eps = T::default_epsilon();
+            let scale = q.amax().max(T::one());
+            eps * scale * scale + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax()
+        };
+        let mut relinearisations = 0;
+        if self.fresh {
+            for _ in 0..RELINEARISATIONS {
+                let Some(cross) = propagation.cross else {
+                    break;
+                };
+                let p = &propagation.p;
+                let Ok((_, chol)) = innovation_factor(&p.qq, &measurement, floor(p)) else {
+                    break;
+                };
+                let w = chol.solve(&(q - q_pred));
+                let next = (
+                    self.q + cross.qq.transpose() * w,
+                    saturate(
+                        &(v0 + cross.qv.transpose() * w),
+                        self.params.observer.velocity_bound,
+                    ),
+                );
+                let step = (next.1 - linearised.1).amax();
+                let mut again = unpredicted;
+                let Ok(end) = self.predict(&interval, &v0, next, &mut again) else {
+                    break;
+                };
+                (q_pred, v_pred, propagation) = end;
+                (linearised, report) = (next, again);
+                relinearisations += 1;
+                let tolerance = T::default_epsilon().sqrt() * (T::one() + next.1.amax());
+                if step <= tolerance {
+                    break;
+                }
+            }
+        }
         let mut p = propagation.p;
         let mut kalman = KalmanReport {
             saltations: propagation.saltations,
             projections: propagation.projections,
+            relinearisations,
             ..KalmanReport::empty()
         };
         // GATE the innovation
@@ -740,9 +816,7 @@ where
         // R, plus the rounding of a sample stored in T (ε|q|) and of the
         // covariance itself (64 ε its largest variance), so that exact
         // samples (R = 0) never leave S singular
-        let eps = T::default_epsilon();
-        let scale = q.amax().max(T::one());
-        let floor = eps * scale * scale + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax();
+        let floor = floor(&p);
         let mut outliers = self.outliers;
         let gate = self.params.gate;
         let factored = innovation_factor(&p.qq, &self.params.measurement, floor)
@@ -767,7 +841,7 @@ where
             // from the measurement, as after a failed prediction (refusing
             // the sample would keep that state, and refuse every sample
             // after it)
-            let point = restart_point(&interval, &self.v, Restart::Infeasible, fresh)?;
+            let point = restart_point(&last, &self.v, Restart::Infeasible, opened)?;
             return Ok(self.restarted(point));
         };
         kalman.nis = nis;
@@ -812,9 +886,57 @@ where
         }
         let v_new = saturate(&v_new, self.params.observer.velocity_bound);
         report.outliers = self.screen.accept();
+        if !kalman.outlier {
+            (self.sample, self.fresh) = (*q, false);
+        }
         (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
         Ok(Self::estimate(self))
+    }
+}
+
+/// A prediction: the predicted end `(q, v)` and the propagation that
+/// followed the covariance to it.
+type Predicted<'m, M, T, const N: usize, const K: usize> =
+    (SVector<T, N>, SVector<T, N>, Propagation<'m, M, T, N, K>);
+
+/// The most predictions the first update after a start or a restart makes
+/// again at a new linearisation point (module docs, step 1,
+/// "Relinearised"): Gauss–Newton converges in two or three where the prior
+/// velocity is a guess.
+const RELINEARISATIONS: usize = 4;
+
+impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
+    /// The interval's prediction, its covariance following every piece and
+    /// impact, from the linearisation point `(q, w)`: `(q̂_k, v0)`, the
+    /// prior's mean with its velocity held to `C_v`, except when
+    /// relinearising. The first update after a start or a restart also
+    /// carries the prior's deviation from that point and `Φ P_k`
+    /// ([`Propagation::relinearised`]). Returns the predicted end
+    /// `φ(x_lin) + Φ (x̂_k − x_lin)`, moved onto a contact manifold where
+    /// the last piece held one, and the propagation.
+    fn predict<'m, M>(
+        &self,
+        interval: &Interval<'m, M, T, N, K>,
+        v0: &SVector<T, N>,
+        (q, w): (SVector<T, N>, SVector<T, N>),
+        report: &mut UpdateReport<T, N, K>,
+    ) -> Result<Predicted<'m, M, T, N, K>, T>
+    where
+        M: Sensitivities<N, K, Scalar = T>,
+    {
+        let mut propagation =
+            Propagation::new(interval.model, interval.u, self.t, &self.params, self.p);
+        if self.fresh {
+            propagation = propagation.relinearised((self.q - q, v0 - w));
+        }
+        let from = Interval { q0: q, ..*interval };
+        let (q_end, v_end) = from.predict_traced(&w, report, &mut propagation)?;
+        Ok((
+            q_end + propagation.correction.0 + propagation.offset.0,
+            v_end + propagation.correction.1 + propagation.offset.1,
+            propagation,
+        ))
     }
 }
 
@@ -823,10 +945,11 @@ where
 type RestartPoint<T, const N: usize, const K: usize> =
     (T, SVector<T, N>, SVector<T, N>, UpdateReport<T, N, K>);
 
-/// The restart at the end of `interval` for `why`, from the report `fresh`
+/// The restart at the end of `interval` for `why`, from the report `opened`
 /// of the interval's start: the observers' restart velocity (`v̂_k` kept
-/// after a run of outliers, else the mean velocity over the interval, held
-/// to `C_v` and closed at the measurement).
+/// after a run of outliers, else the mean velocity over `interval`, held
+/// to `C_v` and closed at the measurement; the filter opens that interval
+/// at the last sample it used).
 fn restart_point<M, T, const N: usize, const K: usize>(
     interval: &Interval<'_, M, T, N, K>,
     v_k: &SVector<T, N>,
@@ -851,6 +974,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         let p = Blocks::diagonal(self.params.measurement, SMatrix::identity() * (s * s));
         report.outliers = self.screen.accept();
         (self.t, self.q, self.v, self.p) = (t, q, v, p);
+        (self.sample, self.fresh) = (q, true);
         (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
         Self::estimate(self)
     }

@@ -87,8 +87,15 @@ where
     /// `δ̄`, the mean delay of an impact.
     delay: T,
     /// The predicted end's shift from the mean delays of the impacts so
-    /// far, carried to the end of the last piece (module docs).
+    /// far, carried to the end of the last piece (module docs), plus the
+    /// prior's deviation from the linearisation point when the filter
+    /// relinearises ([`Propagation::relinearised`]).
     pub offset: (SVector<T, N>, SVector<T, N>),
+    /// Whether `offset` is carried (a mean delay, or a relinearisation).
+    carry: bool,
+    /// `Φ P_k`, the covariance of the predicted end with the start, when
+    /// the filter relinearises (`None` otherwise: no work).
+    pub cross: Option<Blocks<T, N>>,
     pub saltations: u32,
     pub projections: u32,
 }
@@ -120,17 +127,39 @@ where
             correction: (SVector::zeros(), SVector::zeros()),
             delay: params.impact_delay,
             offset: (SVector::zeros(), SVector::zeros()),
+            carry: params.impact_delay != T::zero(),
+            cross: None,
             saltations: 0,
             projections: 0,
         }
     }
 
-    /// Carries the mean delay's offset through the linear map `map` (a
-    /// piece's transition, an impact's saltation, a projection). Nothing
-    /// to carry, and no work, without a mean delay (the default).
+    /// The same propagation for a prediction linearised at a point other
+    /// than the prior's mean: `deviation` (the prior's mean minus that
+    /// point) is carried to the end as the offset is, so that the
+    /// predicted end is `φ(x_lin) + Φ (x̂_k − x_lin)`, and `Φ P_k` is
+    /// followed in [`Propagation::cross`] (see the filter's
+    /// relinearisation in `runtime/src/observer/kalman/mod.rs`).
+    pub fn relinearised(self, deviation: (SVector<T, N>, SVector<T, N>)) -> Self {
+        Self {
+            offset: deviation,
+            carry: true,
+            cross: Some(self.p),
+            ..self
+        }
+    }
+
+    /// Carries the offset (the mean delays', a relinearisation's
+    /// deviation) and `Φ P_k` through the linear map `map` (a piece's
+    /// transition, an impact's saltation, a projection). Nothing to carry,
+    /// and no work, without a mean delay (the default) or a
+    /// relinearisation.
     fn carry_offset(&mut self, map: &Blocks<T, N>) {
-        if self.delay != T::zero() {
+        if self.carry {
             self.offset = map.apply(&self.offset.0, &self.offset.1);
+        }
+        if let Some(cross) = &mut self.cross {
+            *cross = map.mul(cross);
         }
     }
 }
