@@ -98,6 +98,9 @@ where
     pub cross: Option<Blocks<T, N>>,
     pub saltations: u32,
     pub projections: u32,
+    /// The constraints held along the last piece (pushing), if it ended
+    /// the interval: the contacts the predicted end lies on.
+    pub held: IndexSet<K>,
 }
 
 impl<'a, M, T, const N: usize, const K: usize> Propagation<'a, M, T, N, K>
@@ -131,6 +134,7 @@ where
             cross: None,
             saltations: 0,
             projections: 0,
+            held: IndexSet::EMPTY,
         }
     }
 
@@ -268,6 +272,7 @@ where
         } else {
             constrained_flow_jacobian(self.model, t, piece.p0, &w0, self.u, held)?
         };
+        self.held = held;
         let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
         let phi = transition(&a, piece.h);
         let mut p = phi.congruence(&self.p).add(&noise);
@@ -318,6 +323,7 @@ where
         if active.is_empty() {
             return Ok(());
         }
+        self.held = IndexSet::EMPTY;
         // the impact time moves with the constraint whose root timed it
         // (the fastest-approaching if several), for an elastic law only
         let jac = jump.jac;
