@@ -934,13 +934,20 @@ where
     /// restitution only when it approaches faster than
     /// `v_rest,i + g_i u`, with `u` the estimate's [`uncertainty`](Self::uncertainty):
     /// slower, it is closed plastically.
+    ///
+    /// Constraints `touched` (reached by a root here) and `held` (held
+    /// along the piece that led here) are closed whatever the sign of
+    /// their gap: a held contact keeps the normal speed the rule took for
+    /// rest, and drifts by it (on exact samples of the billiard, 8e-9 m
+    /// in 0.8 ms), so that a band of zero would read it open at the next
+    /// event and resolve an impact on another constraint without it.
     #[inline(always)]
     fn classify(
         &self,
         at: &Point<'_, T, N>,
         (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
         resolved: IndexSet<K>,
-        touched: IndexSet<K>,
+        (touched, held): (IndexSet<K>, IndexSet<K>),
     ) -> Result<Classes<K>, T> {
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
         let band = self.params.contact_band();
@@ -949,14 +956,15 @@ where
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
         let four: T = nalgebra::convert(4.0);
         let mut closed = IndexSet::<K>::EMPTY;
+        let kept = touched.union(held);
         for i in 0..K {
             let row = jac.row(i);
-            if !touched.contains(i) && clearly_open(h[i], row.norm_squared(), band) {
+            if !kept.contains(i) && clearly_open(h[i], row.norm_squared(), band) {
                 c.free.insert(i);
                 continue;
             }
             let g = row.norm();
-            if h[i] <= g * band || touched.contains(i) {
+            if h[i] <= g * band || kept.contains(i) {
                 closed.insert(i);
             } else {
                 c.free.insert(i);
@@ -1068,7 +1076,7 @@ where
     }
 
     /// [`classify`](Self::classify), with its common case first and
-    /// inlined: every constraint clearly open and none touched, so all
+    /// inlined: every constraint clearly open and none touched or held, so all
     /// free (the classes built whole where they are read: set one entry at
     /// a time in `classify`, they cost a store-forwarding stall there).
     #[inline(always)]
@@ -1077,17 +1085,19 @@ where
         at: &Point<'_, T, N>,
         (h, jac): (&SVector<T, K>, &SMatrix<T, K, N>),
         resolved: IndexSet<K>,
-        touched: IndexSet<K>,
+        (touched, held): (IndexSet<K>, IndexSet<K>),
     ) -> Result<Classes<K>, T> {
         let band = self.params.contact_band();
-        if touched.is_empty() && (0..K).all(|i| clearly_open(h[i], jac.row(i).norm_squared(), band))
+        if touched.is_empty()
+            && held.is_empty()
+            && (0..K).all(|i| clearly_open(h[i], jac.row(i).norm_squared(), band))
         {
             return Ok(Classes {
                 free: IndexSet::full(K),
                 ..Classes::default()
             });
         }
-        self.classify(at, (h, jac), resolved, touched)
+        self.classify(at, (h, jac), resolved, (touched, held))
     }
 
     /// How close in time the search locates a crossing, and how close two
@@ -1357,7 +1367,8 @@ where
             w: v,
             free: &free,
         };
-        let c = self.classify(&point, (&h, &jac), IndexSet::EMPTY, IndexSet::EMPTY)?;
+        let none = IndexSet::EMPTY;
+        let c = self.classify(&point, (&h, &jac), none, (none, none))?;
         let at = Contact {
             s: self.tau,
             w: v,

@@ -93,6 +93,8 @@ where
         // sign of their gap)
         let mut resolved = IndexSet::EMPTY;
         let mut touched = IndexSet::EMPTY;
+        // and held along the piece that led here (closed as well)
+        let mut held = IndexSet::EMPTY;
         let mut round = 0;
         loop {
             round += 1;
@@ -107,7 +109,7 @@ where
                 w: &w,
                 free: &free,
             };
-            let c = self.classes(&point, (&h, &jac), resolved, touched)?;
+            let c = self.classes(&point, (&h, &jac), resolved, (touched, held))?;
             // IMPACT now, on the closed constraints met approaching
             if !c.approaching.is_empty() && !last_round {
                 let elastic = if report.impacts < max_impacts {
@@ -178,7 +180,7 @@ where
                     })?;
                     report.impulses += part.impulse;
                     (s, p, w) = (s + at, part.p, part.w);
-                    (resolved, touched) = (IndexSet::EMPTY, set);
+                    (resolved, touched, held) = (IndexSet::EMPTY, set, c.sliding);
                     continue;
                 }
             }
