@@ -39,6 +39,11 @@ pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> 
     pub s: T,
     pub p: &'a SVector<T, N>,
     pub w_minus: &'a SVector<T, N>,
+    /// The post-impact velocity the law gave: Newton's with the LCP, or,
+    /// where that would put energy in or the constraints oppose, Moreau's
+    /// or one constraint at a time (the contact rule in
+    /// `runtime/src/observer/mod.rs`).
+    pub w_plus: &'a SVector<T, N>,
     pub lambda: &'a SVector<T, K>,
     pub set: IndexSet<K>,
     pub elastic: IndexSet<K>,
@@ -130,6 +135,7 @@ where
                     s,
                     p: &p,
                     w_minus: &w,
+                    w_plus: &w_plus,
                     lambda: &lambda,
                     set: c.contact,
                     elastic,

@@ -44,7 +44,9 @@
 //!      LCP's outcome), `ê_i` where the law was elastic and `0` where
 //!      plastic, the impact time moved by the constraint whose root timed
 //!      it (none for a plastic closure or a law met at a closed constraint:
-//!      then `Ξ = DΔ`, the reset's Jacobian);
+//!      then `Ξ = DΔ`, the reset's Jacobian; where the contact rule met
+//!      the constraints one at a time, the product of the single impacts'
+//!      `Ξ`, module `propagate`);
 //!    - a piece of persistent contact on the set `S` (the constraints whose
 //!      multiplier pushed along it): the Jacobian of the constrained flow
 //!      ([`constrained_flow_jacobian`]), `P ← Φ P Φᵀ + Q(h)`, then `P`

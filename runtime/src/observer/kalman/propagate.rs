@@ -34,6 +34,23 @@
 //! [`tune_process_noise`](super::tune_process_noise) picks all four knobs
 //! from a recorded run.
 //!
+//! # An impact met one constraint at a time
+//!
+//! Where the contact rule meets the constraints of an impact one at a
+//! time (nearly opposite gradients, or an impact problem without a
+//! solution in floating point: module docs of
+//! `runtime/src/observer/mod.rs`), the velocity after it is not Newton's
+//! law on the set, and neither is its saltation: the covariance goes
+//! through the product of the single impacts' saltation matrices at the
+//! same point, in the rule's order (fastest approach first, each
+//! constraint once), the first timed by the root that found the impact
+//! and the later ones untimed. The product is used when it reproduces the
+//! velocity the rule gave; otherwise (Moreau's law with the least
+//! restitution, which replaces Newton's where Newton's puts energy in)
+//! Newton's saltation is kept, an approximation. On the double pendulum's
+//! corner this took the filter's largest error in the accumulations from
+//! 7.7e-2 to 6.2e-3 rad/s (`tests/kalman.rs`, `full_reach`).
+//!
 //! # The mean delay of an impact
 //!
 //! A shift `δ̄ d` of the state just after an impact is a perturbation of
@@ -344,16 +361,23 @@ where
             .map(|(i, _)| i);
         self.correction = (SVector::zeros(), SVector::zeros());
         let w = saturate(jump.w_minus, self.bound);
-        let s = saltation(
-            self.model,
-            self.t0 + jump.s,
-            jump.p,
-            &w,
-            self.u,
-            active,
-            &e,
-            guard,
-        )?;
+        let t = self.t0 + jump.s;
+        let mut s = saltation(self.model, t, jump.p, &w, self.u, active, &e, guard)?;
+        // where the contact rule met the constraints one at a time
+        // (opposed gradients, or no solution), the map is the product of
+        // single impacts, not Newton's law on the set (module docs)
+        let tolerance = T::default_epsilon().sqrt() * (T::one() + w.norm());
+        if (s.v_plus - jump.w_plus).norm() > tolerance {
+            let mut e_set = SVector::<T, K>::zeros();
+            for i in jump.elastic.iter().filter(|&i| i < K) {
+                e_set[i] = jump.restitution[i];
+            }
+            if let Some(one) = self.one_at_a_time(jump, &w, &e_set, guard)? {
+                if (one.v_plus - jump.w_plus).norm() <= tolerance {
+                    s = one;
+                }
+            }
+        }
         // a gap's root timed the impact: it has an instant, uncertain by
         // σ_t and late on average by δ̄ (a closure the LCP makes at the
         // start of a piece has neither)
@@ -367,5 +391,61 @@ where
         }
         self.saltations += 1;
         Ok(())
+    }
+}
+
+impl<M, T, const N: usize, const K: usize> Propagation<'_, M, T, N, K>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    /// The saltation of an impact that the contact rule resolved one
+    /// constraint at a time (the fastest approach first, each once, as
+    /// `Interval::one_at_a_time` does): the product of the single
+    /// constraints' saltations at the same point, the first timed by the
+    /// guard, the later ones untimed (they follow at once), and the timing
+    /// direction carried through the later ones. `None` when no constraint
+    /// of the set approaches.
+    fn one_at_a_time(
+        &self,
+        jump: &Jump<'_, T, N, K>,
+        w: &SVector<T, N>,
+        e: &SVector<T, K>,
+        guard: Option<usize>,
+    ) -> Result<Option<Saltation<T, N, K>>, T> {
+        let t = self.t0 + jump.s;
+        let mut left = jump.set;
+        let mut composed: Option<Saltation<T, N, K>> = None;
+        let mut v = *w;
+        while let Some((i, _)) = left
+            .iter()
+            .filter(|&i| i < K)
+            .map(|i| (i, jump.jac.row(i).dot(&v.transpose())))
+            .filter(|&(_, jw)| jw < T::zero())
+            .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
+        {
+            left.remove(i);
+            let mut single = IndexSet::EMPTY;
+            single.insert(i);
+            let timed = if composed.is_none() {
+                guard.filter(|&g| g == i)
+            } else {
+                None
+            };
+            let step = saltation(self.model, t, jump.p, &v, self.u, single, e, timed)?;
+            v = step.v_plus;
+            composed = Some(match composed {
+                None => step,
+                Some(before) => Saltation {
+                    matrix: step.matrix.mul(&before.matrix),
+                    reset_dv: step.reset_dv * before.reset_dv,
+                    reset_dq: step.reset_dq + step.reset_dv * before.reset_dq,
+                    timing: step.matrix.apply(&before.timing.0, &before.timing.1),
+                    lambda: before.lambda + step.lambda,
+                    ..step
+                },
+            });
+        }
+        Ok(composed)
     }
 }
