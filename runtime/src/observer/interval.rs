@@ -148,6 +148,21 @@ fn opposed<T: RealField + Copy, const K: usize>(
     taken > four * carried
 }
 
+/// The constraint of `left` that `w` approaches fastest, the most
+/// negative normal speed `J_i w < 0`, and that speed; `None` when none
+/// approaches. The order in which [`Interval::one_at_a_time`] meets a set's
+/// constraints, and in which the filter composes their saltations.
+pub(crate) fn fastest_approach<T: RealField + Copy, const N: usize, const K: usize>(
+    jac: &SMatrix<T, K, N>,
+    w: &SVector<T, N>,
+    left: IndexSet<K>,
+) -> Option<(usize, T)> {
+    left.iter()
+        .map(|i| (i, jac.row(i).dot(&w.transpose())))
+        .filter(|&(_, jw)| jw < T::zero())
+        .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
+}
+
 /// Whether a constraint inside the band but still open (`h > 0`),
 /// approached at the normal speed `J_i w = jw < 0`, is turned back by its
 /// own normal acceleration `α = J_i a + J̇_i w > 0` before its gap is
@@ -688,12 +703,7 @@ where
     ) -> SVector<T, N> {
         let mut dv = SVector::<T, N>::zeros();
         let mut left = set;
-        while let Some((i, jw)) = left
-            .iter()
-            .map(|i| (i, at.jac.row(i).dot(&(at.w + dv).transpose())))
-            .filter(|&(_, jw)| jw < T::zero())
-            .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
-        {
+        while let Some((i, jw)) = fastest_approach(at.jac, &(at.w + dv), left) {
             left.remove(i);
             let delassus = at.jac.row(i).dot(&minv_jt.column(i).transpose());
             let lambda = -(T::one() + e[i]) * jw / delassus;

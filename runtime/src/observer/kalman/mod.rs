@@ -755,16 +755,13 @@ where
         interval.uncertainty = rule.noise_sigmas * sigma_v;
         // no injection: the filter's correction is its Kalman gain
         report.gain = T::zero();
-        // PREDICT, the covariance following every piece and impact
-        // (the restart's velocity from the last sample used, not from an
-        // estimate that may be what failed)
-        let last = Interval {
-            q0: self.sample,
-            ..interval
-        };
+        // PREDICT, the covariance following every piece and impact (a
+        // restart takes its velocity from the last sample used, not from
+        // an estimate that may be what failed: `restart_point`)
         let v0 = saturate(&self.v, self.params.observer.velocity_bound);
         let mut linearised = (self.q, v0);
-        let unpredicted = report;
+        // the report before the prediction, for the relinearisations
+        let unpredicted = self.fresh.then_some(report);
         let predicted = match plan {
             Plan::Integrate => self
                 .predict(&interval, &v0, linearised, &mut report)
@@ -777,7 +774,8 @@ where
             // from the filter's own state: start again from the
             // measurement, as the observers do
             Err(why) => {
-                return Ok(self.restarted(restart_point(&last, &self.v, why, opened)?));
+                let point = restart_point(&interval, &self.sample, &self.v, why, opened)?;
+                return Ok(self.restarted(point));
             }
         };
         // RELINEARISE the first update after a start or a restart, whose
@@ -789,7 +787,7 @@ where
             eps * scale * scale + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax()
         };
         let mut relinearisations = 0;
-        if self.fresh {
+        if let Some(unpredicted) = unpredicted {
             for _ in 0..RELINEARISATIONS {
                 let Some(cross) = propagation.cross else {
                     break;
@@ -876,7 +874,13 @@ where
             // from the measurement, as after a failed prediction (refusing
             // the sample would keep that state, and refuse every sample
             // after it)
-            let point = restart_point(&last, &self.v, Restart::Infeasible, opened)?;
+            let point = restart_point(
+                &interval,
+                &self.sample,
+                &self.v,
+                Restart::Infeasible,
+                opened,
+            )?;
             return Ok(self.restarted(point));
         };
         kalman.nis = nis;
@@ -1046,11 +1050,12 @@ type RestartPoint<T, const N: usize, const K: usize> =
 
 /// The restart at the end of `interval` for `why`, from the report `opened`
 /// of the interval's start: the observers' restart velocity (`v̂_k` kept
-/// after a run of outliers, else the mean velocity over `interval`, held
-/// to `C_v` and closed at the measurement; the filter opens that interval
-/// at the last sample it used).
+/// after a run of outliers, else the mean velocity over the interval, held
+/// to `C_v` and closed at the measurement), the interval opened at
+/// `sample`, the last sample the filter used, not at its estimate.
 fn restart_point<M, T, const N: usize, const K: usize>(
     interval: &Interval<'_, M, T, N, K>,
+    sample: &SVector<T, N>,
     v_k: &SVector<T, N>,
     why: Restart,
     mut report: UpdateReport<T, N, K>,
@@ -1059,7 +1064,11 @@ where
     T: RealField + Copy,
     M: Model<N, K, Scalar = T>,
 {
-    let v = restart_velocity(interval, v_k, why, &mut report)?;
+    let interval = Interval {
+        q0: *sample,
+        ..*interval
+    };
+    let v = restart_velocity(&interval, v_k, why, &mut report)?;
     Ok((interval.t0 + interval.tau, interval.q1, v, report))
 }
 

@@ -71,7 +71,7 @@ use crate::model::Sensitivities;
 use crate::validate::{self, factor_mass};
 
 use super::super::ObserverError;
-use super::super::interval::{Flight, Jump, Tracer, saturate};
+use super::super::interval::{Flight, Jump, Tracer, fastest_approach, saturate};
 use super::saltation::{
     Saltation, constrained_flow_jacobian, flow_jacobian, project_onto_contact, saltation,
     transition,
@@ -267,6 +267,50 @@ where
         }
         Ok(noise)
     }
+
+    /// The saltation of an impact that the contact rule resolved one
+    /// constraint at a time (the fastest approach first, each once, as
+    /// `Interval::one_at_a_time` does): the product of the single
+    /// constraints' saltations at the same point, the first timed by the
+    /// guard, the later ones untimed (they follow at once), and the timing
+    /// direction carried through the later ones. `None` when no constraint
+    /// of the set approaches.
+    fn one_at_a_time(
+        &self,
+        jump: &Jump<'_, T, N, K>,
+        w: &SVector<T, N>,
+        e: &SVector<T, K>,
+        guard: Option<usize>,
+    ) -> Result<Option<Saltation<T, N, K>>, T> {
+        let t = self.t0 + jump.s;
+        let mut left = jump.set;
+        let mut composed: Option<Saltation<T, N, K>> = None;
+        let mut v = *w;
+        while let Some((i, _)) = fastest_approach(jump.jac, &v, left) {
+            left.remove(i);
+            let mut single = IndexSet::EMPTY;
+            single.insert(i);
+            let timed = if composed.is_none() {
+                guard.filter(|&g| g == i)
+            } else {
+                None
+            };
+            let step = saltation(self.model, t, jump.p, &v, self.u, single, e, timed)?;
+            v = step.v_plus;
+            composed = Some(match composed {
+                None => step,
+                Some(before) => Saltation {
+                    matrix: step.matrix.mul(&before.matrix),
+                    reset_dv: step.reset_dv * before.reset_dv,
+                    reset_dq: step.reset_dq + step.reset_dv * before.reset_dq,
+                    timing: step.matrix.apply(&before.timing.0, &before.timing.1),
+                    lambda: before.lambda + step.lambda,
+                    ..step
+                },
+            });
+        }
+        Ok(composed)
+    }
 }
 
 impl<M, T, const N: usize, const K: usize> Tracer<T, N, K> for Propagation<'_, M, T, N, K>
@@ -391,61 +435,5 @@ where
         }
         self.saltations += 1;
         Ok(())
-    }
-}
-
-impl<M, T, const N: usize, const K: usize> Propagation<'_, M, T, N, K>
-where
-    T: RealField + Copy,
-    M: Sensitivities<N, K, Scalar = T>,
-{
-    /// The saltation of an impact that the contact rule resolved one
-    /// constraint at a time (the fastest approach first, each once, as
-    /// `Interval::one_at_a_time` does): the product of the single
-    /// constraints' saltations at the same point, the first timed by the
-    /// guard, the later ones untimed (they follow at once), and the timing
-    /// direction carried through the later ones. `None` when no constraint
-    /// of the set approaches.
-    fn one_at_a_time(
-        &self,
-        jump: &Jump<'_, T, N, K>,
-        w: &SVector<T, N>,
-        e: &SVector<T, K>,
-        guard: Option<usize>,
-    ) -> Result<Option<Saltation<T, N, K>>, T> {
-        let t = self.t0 + jump.s;
-        let mut left = jump.set;
-        let mut composed: Option<Saltation<T, N, K>> = None;
-        let mut v = *w;
-        while let Some((i, _)) = left
-            .iter()
-            .filter(|&i| i < K)
-            .map(|i| (i, jump.jac.row(i).dot(&v.transpose())))
-            .filter(|&(_, jw)| jw < T::zero())
-            .min_by(|a, b| a.1.partial_cmp(&b.1).unwrap_or(core::cmp::Ordering::Equal))
-        {
-            left.remove(i);
-            let mut single = IndexSet::EMPTY;
-            single.insert(i);
-            let timed = if composed.is_none() {
-                guard.filter(|&g| g == i)
-            } else {
-                None
-            };
-            let step = saltation(self.model, t, jump.p, &v, self.u, single, e, timed)?;
-            v = step.v_plus;
-            composed = Some(match composed {
-                None => step,
-                Some(before) => Saltation {
-                    matrix: step.matrix.mul(&before.matrix),
-                    reset_dv: step.reset_dv * before.reset_dv,
-                    reset_dq: step.reset_dq + step.reset_dv * before.reset_dq,
-                    timing: step.matrix.apply(&before.timing.0, &before.timing.1),
-                    lambda: before.lambda + step.lambda,
-                    ..step
-                },
-            });
-        }
-        Ok(composed)
     }
 }
