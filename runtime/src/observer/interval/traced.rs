@@ -13,7 +13,7 @@ use crate::lcp::IndexSet;
 use crate::model::Model;
 
 use super::{
-    Contact, Crossing, Free, Interval, Point, Result, Segment, UpdateReport, check_contact,
+    Contact, Crossing, Free, Interval, Path, Point, Result, Segment, UpdateReport, check_contact,
 };
 
 /// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
@@ -94,12 +94,12 @@ where
         let max_rounds = max_impacts.saturating_mul(2).saturating_add(8);
         let (mut s, mut p, mut w) = (T::zero(), self.q0, *v0);
         // constraints that met Newton's law at this point (no second law
-        // here), and reached by a root at this point (closed whatever the
-        // sign of their gap)
+        // here), and how the prediction came here (touched, held, bounced)
         let mut resolved = IndexSet::EMPTY;
-        let mut touched = IndexSet::EMPTY;
-        // and held along the piece that led here (closed as well)
-        let mut held = IndexSet::EMPTY;
+        let mut path = Path {
+            bounced: self.last_impacted,
+            ..Path::default()
+        };
         let mut round = 0;
         loop {
             round += 1;
@@ -114,7 +114,7 @@ where
                 w: &w,
                 free: &free,
             };
-            let c = self.classes(&point, (&h, &jac), resolved, (touched, held))?;
+            let c = self.classes(&point, (&h, &jac), resolved, path)?;
             // IMPACT now, on the closed constraints met approaching
             if !c.approaching.is_empty() && !last_round {
                 let elastic = if report.impacts < max_impacts {
@@ -131,6 +131,11 @@ where
                 };
                 let w_plus = self.newton(&at, c.contact, elastic, report)?;
                 let lambda = report.impulses - before;
+                for i in elastic {
+                    if lambda[i] > T::zero() {
+                        path.bounced.insert(i);
+                    }
+                }
                 tracer.jump(&Jump {
                     s,
                     p: &p,
@@ -139,14 +144,14 @@ where
                     lambda: &lambda,
                     set: c.contact,
                     elastic,
-                    guard: touched.intersection(c.approaching),
+                    guard: path.touched.intersection(c.approaching),
                     restitution: &self.restitution,
                     jac: &jac,
                     free: &free,
                 })?;
                 w = w_plus;
                 resolved = resolved.union(c.approaching);
-                touched = touched.union(c.approaching);
+                path.touched = path.touched.union(c.approaching);
                 continue;
             }
             // FLIGHT (and sliding) to the end of the interval
@@ -186,7 +191,7 @@ where
                     })?;
                     report.impulses += part.impulse;
                     (s, p, w) = (s + at, part.p, part.w);
-                    (resolved, touched, held) = (IndexSet::EMPTY, set, c.sliding);
+                    (resolved, path.touched, path.held) = (IndexSet::EMPTY, set, c.sliding);
                     continue;
                 }
             }
