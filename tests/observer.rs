@@ -8,9 +8,9 @@
 //! every measured figure.
 
 use moreau::{
-    DataError, Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion, Model,
-    ModelBounds, MoreauJean, Observer, ObserverError, ObserverParams, ReducedOrder, Restart, State,
-    StepParams,
+    DataError, Design, Discretization, Estimate, FullOrder, FullOrderGains, GainRegion,
+    KalmanParams, Model, ModelBounds, MoreauJean, Observer, ObserverError, ObserverParams,
+    ReducedOrder, Restart, SaltationKalman, State, StepParams,
 };
 mod common;
 
@@ -1528,4 +1528,100 @@ fn a_long_gap_gives_a_bounded_flagged_estimate() {
     assert_eq!(ro.report().restart, Some(Restart::LongInterval));
     ro.update(&model, 1.001, &q0, &u).unwrap();
     assert_eq!(ro.report().restart, None);
+}
+
+// ---------------------------------------------------------------------------
+// Speeds above the velocity bound
+
+/// `UpdateReport::at_velocity_bound` on Example 1 (the model file's start,
+/// plant at `τ = 1e-5`, samples at 1 kHz, exact and with `σ = 1e-4`,
+/// `v̂(0) = 0`), for (38), (36) and the saltation Kalman filter, each
+/// told `σ`. With `C_v = 5` the mass moves faster than the bound for much
+/// of the run (up to 12.3 m/s, sliding fast along the steep floor before
+/// it settles): the estimates cannot follow (they are held to `C_v`, and
+/// most samples are refused as farther than `C_v` lets the system move),
+/// and the report must say so on every sample from 1 s on where the true
+/// speed is above `1.25 C_v`, and on none where it is below `0.75 C_v`
+/// (the samples that bracket a plant impact left out: the jump falls
+/// between them). With `C_v = 20`, above every speed of the run, it is
+/// never set. A sample refused as an outlier leaves the report of the
+/// update before it.
+#[test]
+fn the_report_says_when_the_velocity_bound_holds_the_estimate() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::<f64, 0>::zeros();
+    let data = reference(&model, Parabola::<f64>::initial_state(), 1e-5, 100, 6.0, &u);
+    let fastest = data.samples.iter().map(|s| s.v.norm()).fold(0.0, f64::max);
+    assert!(fastest > 10.0 && fastest < 15.0, "{fastest}");
+    let bracket = common::runs::brackets(&data);
+    for (sigma, c_v) in [(0.0, 5.0), (1e-4, 5.0), (0.0, 20.0), (1e-4, 20.0)] {
+        let measured = measure(&data, sigma, 3);
+        let start = (measured[0], Vector2::zeros());
+        let params = ObserverParams::new(10.0, c_v).with_noise(sigma);
+        let flags = |o: &mut dyn Observer<Parabola<f64>, 2, 2>| -> Vec<bool> {
+            let mut flags = vec![false];
+            for (s, q) in data.samples.iter().zip(&measured).skip(1) {
+                match o.update(&model, s.t, q, &u) {
+                    Ok(_) | Err(ObserverError::Outlier { .. }) => {}
+                    Err(e) => panic!("t = {}: {e:?}", s.t),
+                }
+                flags.push(o.report().at_velocity_bound);
+            }
+            flags
+        };
+        let kalman = KalmanParams::new(c_v, sigma);
+        let runs = [
+            (
+                "(38)",
+                flags(&mut ReducedOrder::new(params, 0.0, start.0, start.1).unwrap()),
+            ),
+            (
+                "(36)",
+                flags(
+                    &mut FullOrder::new(
+                        params,
+                        FullOrderGains::scalar(5.0, 25.0),
+                        0.0,
+                        start.0,
+                        start.1,
+                    )
+                    .unwrap(),
+                ),
+            ),
+            (
+                "filter",
+                flags(
+                    &mut SaltationKalman::<f64, 2, 2>::new(kalman, 0.0, start.0, start.1).unwrap(),
+                ),
+            ),
+        ];
+        for (name, flags) in runs {
+            let at = format!("{name}, σ = {sigma:e}, C_v = {c_v}");
+            let (mut above, mut set) = (0, 0);
+            for ((s, &flag), &b) in data.samples.iter().zip(&flags).zip(&bracket) {
+                let speed = s.v.norm();
+                set += usize::from(flag);
+                if s.t < 1.0 || b {
+                    continue;
+                }
+                if speed > 1.25 * c_v {
+                    above += 1;
+                    assert!(flag, "{at}, t = {}: |v| = {speed}, not reported", s.t);
+                }
+                assert!(
+                    speed >= 0.75 * c_v || !flag,
+                    "{at}, t = {}: |v| = {speed}, reported",
+                    s.t
+                );
+            }
+            eprintln!(
+                "{at}: {above} samples from 1 s on above 1.25 C_v, all reported; {set} updates at the bound in all"
+            );
+            if c_v == 20.0 {
+                assert_eq!(set, 0, "{at}");
+            } else {
+                assert!(above >= 1000, "{at}: {above}");
+            }
+        }
+    }
 }

@@ -6,7 +6,9 @@ use crate::lcp::Lcp;
 use crate::linalg::{Ldlt, SymmetricEigen};
 use crate::model::Model;
 
-use super::interval::{Cache, Interval, Memory, saturate, saturate_for};
+use super::interval::{
+    Cache, Interval, Memory, hold_to_bound, moved_past_bound, saturate, saturate_for,
+};
 use super::reduced_order::{restart_velocity, section_vii_impact};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
@@ -479,7 +481,15 @@ where
             }
         };
         // WRITEBACK: the velocity estimate held to C_v, as in ReducedOrder
-        let v = saturate(&v, self.params.velocity_bound);
+        let params = &self.params;
+        let (v, held) = hold_to_bound(&v, params.velocity_bound);
+        report.at_velocity_bound |= held
+            || moved_past_bound(
+                (&self.q, q),
+                t - self.t,
+                params.velocity_bound,
+                (params.noise, params.noise_sigmas),
+            );
         report.outliers = self.outliers.accept();
         (self.t, self.q, self.q_hat, self.v, self.report) = (t, *q, q_hat, v, report);
         Ok(Self::estimate(self))

@@ -41,6 +41,32 @@ pub(crate) fn saturate<T: RealField + Copy, const N: usize>(
     if n > bound { v * (bound / n) } else { *v }
 }
 
+/// [`saturate`] for an estimate written back at the end of an update, and
+/// whether the bound held it
+/// ([`UpdateReport::at_velocity_bound`](super::UpdateReport::at_velocity_bound)).
+pub(crate) fn hold_to_bound<T: RealField + Copy, const N: usize>(
+    v: &SVector<T, N>,
+    bound: T,
+) -> (SVector<T, N>, bool) {
+    let held = saturate(v, bound);
+    (held, held != *v)
+}
+
+/// Whether two samples `τ` apart, each with noise `σ` per coordinate,
+/// moved faster than the bound `C_v`: `|q₁ − q₀| > C_v τ + n_σ √(2N) σ`
+/// (`√(2N) σ` the root mean square of the noise in the displacement).
+pub(crate) fn moved_past_bound<T: RealField + Copy, const N: usize>(
+    (q0, q1): (&SVector<T, N>, &SVector<T, N>),
+    tau: T,
+    bound: T,
+    (sigma, n_sigma): (T, T),
+) -> bool {
+    let spread: T = nalgebra::convert((2 * N) as f64);
+    let reach = bound * tau + n_sigma * spread.sqrt() * sigma;
+    // (squared: no root on the path every update takes)
+    (q1 - q0).norm_squared() > reach * reach
+}
+
 /// `F̄ = F(t, q, sat(v))` needs `sat(v)` only when `F` depends on `v`
 /// ([`Structure::forces_velocity_free`](crate::Structure::forces_velocity_free)).
 pub(crate) fn saturate_for<M, T, const N: usize, const K: usize>(

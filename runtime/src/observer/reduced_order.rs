@@ -6,7 +6,9 @@ use nalgebra::{RealField, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
-use super::interval::{Cache, Impacts, Interval, Memory, saturate, saturate_for};
+use super::interval::{
+    Cache, Impacts, Interval, Memory, hold_to_bound, moved_past_bound, saturate, saturate_for,
+};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
     UpdateReport, check_start,
@@ -368,7 +370,8 @@ where
         Restart::Outliers => *v_k,
         Restart::LongInterval | Restart::Infeasible => displacement / interval.tau,
     };
-    let v = saturate(&v, bound);
+    let (v, held) = hold_to_bound(&v, bound);
+    report.at_velocity_bound = held;
     report.restart = Some(why);
     report.innovation = displacement - saturate(v_k, bound) * interval.tau;
     let v = interval.close_at_end(&v, report)?;
@@ -459,7 +462,15 @@ where
         };
         // WRITEBACK: the estimate held to C_v (a radial projection onto a
         // ball that holds the true velocity never moves it away from it)
-        let v = saturate(&v, self.params.velocity_bound);
+        let params = &self.params;
+        let (v, held) = hold_to_bound(&v, params.velocity_bound);
+        report.at_velocity_bound |= held
+            || moved_past_bound(
+                (&self.q, q),
+                t - self.t,
+                params.velocity_bound,
+                (params.noise, params.noise_sigmas),
+            );
         report.outliers = self.outliers.accept();
         (self.t, self.q, self.v, self.report) = (t, *q, v, report);
         self.smooth = smooth;

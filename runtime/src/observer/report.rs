@@ -59,6 +59,19 @@ pub struct UpdateReport<T: RealField + Copy, const N: usize, const K: usize> {
     /// `Some` when this update did not integrate the interval but restarted
     /// the estimate from the measurement, and why.
     pub restart: Option<Restart>,
+    /// Whether the velocity estimate was held to the bound `C_v`
+    /// ([`ObserverParams::velocity_bound`](super::ObserverParams::velocity_bound))
+    /// at the end of this update (its norm would have exceeded it), or, at
+    /// a [`restart`](Self::restart), whether the samples moved faster than
+    /// `C_v` over the interval (the mean velocity past it). The estimators
+    /// take the true velocity to be within `C_v` (Assumption 1; their
+    /// forces are evaluated at `sat(v̂)`, and a sample farther than `C_v`
+    /// lets the system move is refused as an outlier): a run of updates
+    /// with this set says the machine moves faster than the bound they
+    /// were given (or the sensor jumped), and that the estimate
+    /// understates its speed: raise `C_v`. A refused sample leaves the
+    /// report of the update before it.
+    pub at_velocity_bound: bool,
 }
 
 /// Why an update restarted the estimate from the measurement (`q̂ = q`,
@@ -100,6 +113,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> UpdateReport<T, N, K> 
             evaluations: 0,
             outliers: 0,
             restart: None,
+            at_velocity_bound: false,
         }
     }
 

@@ -118,7 +118,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::{Model, Sensitivities};
 
-use super::interval::{Cache, Interval, Memory, saturate};
+use super::interval::{Cache, Interval, Memory, hold_to_bound, moved_past_bound, saturate};
 use super::reduced_order::restart_velocity;
 use super::{
     Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart, UpdateReport,
@@ -923,7 +923,8 @@ where
         if !(finite(&q_new) && finite(&v_new) && p.is_finite()) {
             return Err(ObserverError::Data(DataError::NonFiniteResult));
         }
-        let v_new = saturate(&v_new, self.params.observer.velocity_bound);
+        let (v_new, held) = hold_to_bound(&v_new, self.params.observer.velocity_bound);
+        report.at_velocity_bound = held || self.moved_past_bound(t, q);
         report.outliers = self.screen.accept();
         if !kalman.outlier {
             (self.sample, self.fresh) = (*q, false);
@@ -1073,11 +1074,25 @@ where
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
+    /// Whether the sample `q` at `t` lies farther from the estimate's
+    /// position than `C_v` lets the system move since
+    /// ([`UpdateReport::at_velocity_bound`]).
+    fn moved_past_bound(&self, t: T, q: &SVector<T, N>) -> bool {
+        let observer = &self.params.observer;
+        moved_past_bound(
+            (&self.q, q),
+            t - self.t,
+            observer.velocity_bound,
+            (observer.noise, observer.noise_sigmas),
+        )
+    }
+
     /// The filter started again at `(t, q)` with the velocity `v`
     /// ([`restart_point`]) and the covariance of a fresh filter (`R` on the
     /// position, [`KalmanParams::initial_velocity_sigma`]`²` on the
     /// velocity); `report` records why.
     fn restarted(&mut self, (t, q, v, mut report): RestartPoint<T, N, K>) -> Estimate<T, N> {
+        report.at_velocity_bound |= self.moved_past_bound(t, &q);
         let s = self.params.initial_velocity_sigma;
         let p = Blocks::diagonal(self.params.measurement, SMatrix::identity() * (s * s));
         report.outliers = self.screen.accept();
