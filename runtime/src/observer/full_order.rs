@@ -6,9 +6,7 @@ use crate::lcp::Lcp;
 use crate::linalg::{Ldlt, SymmetricEigen};
 use crate::model::Model;
 
-use super::interval::{
-    Cache, Interval, Memory, hold_to_bound, moved_past_bound, saturate, saturate_for,
-};
+use super::interval::{Cache, Interval, Memory, saturate, saturate_for, write_back};
 use super::reduced_order::{restart_velocity, section_vii_impact};
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
@@ -481,15 +479,7 @@ where
             }
         };
         // WRITEBACK: the velocity estimate held to C_v, as in ReducedOrder
-        let params = &self.params;
-        let (v, held) = hold_to_bound(&v, params.velocity_bound);
-        report.at_velocity_bound |= held
-            || moved_past_bound(
-                (&self.q, q),
-                t - self.t,
-                params.velocity_bound,
-                (params.noise, params.noise_sigmas),
-            );
+        let v = write_back(&v, &self.params, (&self.q, q, t - self.t), &mut report);
         report.outliers = self.outliers.accept();
         (self.t, self.q, self.q_hat, self.v, self.report) = (t, *q, q_hat, v, report);
         Ok(Self::estimate(self))

@@ -53,18 +53,33 @@ pub(crate) fn hold_to_bound<T: RealField + Copy, const N: usize>(
 }
 
 /// Whether two samples `τ` apart, each with noise `σ` per coordinate,
-/// moved faster than the bound `C_v`: `|q₁ − q₀| > C_v τ + n_σ √(2N) σ`
-/// (`√(2N) σ` the root mean square of the noise in the displacement).
+/// moved faster than the bound `C_v` (`params`): `|q₁ − q₀| > C_v τ + n_σ
+/// √(2N) σ` (`√(2N) σ` the root mean square of the noise in the
+/// displacement).
 pub(crate) fn moved_past_bound<T: RealField + Copy, const N: usize>(
+    params: &ObserverParams<T>,
     (q0, q1): (&SVector<T, N>, &SVector<T, N>),
     tau: T,
-    bound: T,
-    (sigma, n_sigma): (T, T),
 ) -> bool {
     let spread: T = nalgebra::convert((2 * N) as f64);
-    let reach = bound * tau + n_sigma * spread.sqrt() * sigma;
+    let reach = params.velocity_bound * tau + params.noise_sigmas * spread.sqrt() * params.noise;
     // (squared: no root on the path every update takes)
     (q1 - q0).norm_squared() > reach * reach
+}
+
+/// The velocity estimate written back at the end of an update: `v` held
+/// to `C_v` ([`hold_to_bound`]), the report told whether the bound held it
+/// or the samples `(q₀, q₁)`, `τ` apart, moved past it
+/// ([`moved_past_bound`]).
+pub(crate) fn write_back<T: RealField + Copy, const N: usize, const K: usize>(
+    v: &SVector<T, N>,
+    params: &ObserverParams<T>,
+    (q0, q1, tau): (&SVector<T, N>, &SVector<T, N>, T),
+    report: &mut UpdateReport<T, N, K>,
+) -> SVector<T, N> {
+    let (v, held) = hold_to_bound(v, params.velocity_bound);
+    report.at_velocity_bound |= held || moved_past_bound(params, (q0, q1), tau);
+    v
 }
 
 /// `F̄ = F(t, q, sat(v))` needs `sat(v)` only when `F` depends on `v`

@@ -7,7 +7,7 @@ use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
 use super::interval::{
-    Cache, Impacts, Interval, Memory, hold_to_bound, moved_past_bound, saturate, saturate_for,
+    Cache, Impacts, Interval, Memory, hold_to_bound, saturate, saturate_for, write_back,
 };
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
@@ -462,15 +462,7 @@ where
         };
         // WRITEBACK: the estimate held to C_v (a radial projection onto a
         // ball that holds the true velocity never moves it away from it)
-        let params = &self.params;
-        let (v, held) = hold_to_bound(&v, params.velocity_bound);
-        report.at_velocity_bound |= held
-            || moved_past_bound(
-                (&self.q, q),
-                t - self.t,
-                params.velocity_bound,
-                (params.noise, params.noise_sigmas),
-            );
+        let v = write_back(&v, &self.params, (&self.q, q, t - self.t), &mut report);
         report.outliers = self.outliers.accept();
         (self.t, self.q, self.v, self.report) = (t, *q, v, report);
         self.smooth = smooth;

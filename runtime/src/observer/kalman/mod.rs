@@ -118,7 +118,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::{Model, Sensitivities};
 
-use super::interval::{Cache, Interval, Memory, hold_to_bound, moved_past_bound, saturate};
+use super::interval::{Cache, Interval, Memory, moved_past_bound, saturate, write_back};
 use super::reduced_order::restart_velocity;
 use super::{
     Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart, UpdateReport,
@@ -923,8 +923,14 @@ where
         if !(finite(&q_new) && finite(&v_new) && p.is_finite()) {
             return Err(ObserverError::Data(DataError::NonFiniteResult));
         }
-        let (v_new, held) = hold_to_bound(&v_new, self.params.observer.velocity_bound);
-        report.at_velocity_bound = held || self.moved_past_bound(t, q);
+        // (the move past C_v measured from the estimate's position: the
+        // last sample used may be older than t_k, after a refused one)
+        let v_new = write_back(
+            &v_new,
+            &self.params.observer,
+            (&self.q, q, t - self.t),
+            &mut report,
+        );
         report.outliers = self.screen.accept();
         if !kalman.outlier {
             (self.sample, self.fresh) = (*q, false);
@@ -1074,25 +1080,13 @@ where
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
-    /// Whether the sample `q` at `t` lies farther from the estimate's
-    /// position than `C_v` lets the system move since
-    /// ([`UpdateReport::at_velocity_bound`]).
-    fn moved_past_bound(&self, t: T, q: &SVector<T, N>) -> bool {
-        let observer = &self.params.observer;
-        moved_past_bound(
-            (&self.q, q),
-            t - self.t,
-            observer.velocity_bound,
-            (observer.noise, observer.noise_sigmas),
-        )
-    }
-
     /// The filter started again at `(t, q)` with the velocity `v`
     /// ([`restart_point`]) and the covariance of a fresh filter (`R` on the
     /// position, [`KalmanParams::initial_velocity_sigma`]`²` on the
     /// velocity); `report` records why.
     fn restarted(&mut self, (t, q, v, mut report): RestartPoint<T, N, K>) -> Estimate<T, N> {
-        report.at_velocity_bound |= self.moved_past_bound(t, &q);
+        report.at_velocity_bound |=
+            moved_past_bound(&self.params.observer, (&self.q, &q), t - self.t);
         let s = self.params.initial_velocity_sigma;
         let p = Blocks::diagonal(self.params.measurement, SMatrix::identity() * (s * s));
         report.outliers = self.screen.accept();
