@@ -373,14 +373,18 @@ where
     }
 
     fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T> {
+        // the restitutions of the elastic constraints, and the set that
+        // took an impulse with theirs
+        let mut e_set = SVector::<T, K>::zeros();
+        for i in jump.elastic.iter().filter(|&i| i < K) {
+            e_set[i] = jump.restitution[i];
+        }
         let mut active = IndexSet::EMPTY;
         let mut e = SVector::<T, K>::zeros();
         for i in jump.set.iter().filter(|&i| i < K) {
             if jump.lambda[i] > T::zero() {
                 active.insert(i);
-                if jump.elastic.contains(i) {
-                    e[i] = jump.restitution[i];
-                }
+                e[i] = e_set[i];
             }
         }
         if active.is_empty() {
@@ -414,10 +418,6 @@ where
         // single impacts, not Newton's law on the set (module docs)
         let tolerance = T::default_epsilon().sqrt() * (T::one() + w.norm());
         if (s.v_plus - jump.w_plus).norm() > tolerance {
-            let mut e_set = SVector::<T, K>::zeros();
-            for i in jump.elastic.iter().filter(|&i| i < K) {
-                e_set[i] = jump.restitution[i];
-            }
             if let Some(one) = self.one_at_a_time(jump, &w, &e_set, guard)? {
                 if (one.v_plus - jump.w_plus).norm() <= tolerance {
                     s = one;
