@@ -781,10 +781,30 @@ where
         // RELINEARISE the first update after a start or a restart, whose
         // prior velocity is a guess (module docs, step 1, "Relinearised")
         let measurement = self.params.measurement;
+        // the floor under `R` in `S = P_qq + R`: the rounding of a
+        // coordinate stored in `T` (a few units of `ε |q|`: the sample's
+        // own and the prediction's), plus 64 ε times the largest variance
+        // the covariance holds or has held, in units of position (`P_qq`,
+        // and `τ² P_vv` with the initial `P_vv` as well: an update that
+        // pins the position down from exact samples leaves `P` with
+        // errors of ε times what it held before, and a posterior `P_qq`
+        // below them turns the velocity block indefinite). This is what
+        // keeps exact samples (`R = 0`) from driving `P` indefinite,
+        // without adding noise that a real `R` already dominates: a
+        // floor of `ε |q|²` (half the digits of a coordinate) did the
+        // same but is `√ε |q|` = 1.7e-3 m at `|q|` = 5 in `f32`, and held
+        // the `f32` filter at σ = 1e-4 seven to ten times above the `f64`
+        // one (`tests/kalman.rs`, `runs_in_f32`)
+        let tau = interval.tau;
+        let s0 = self.params.initial_velocity_sigma;
         let floor = |p: &Blocks<T, N>| {
             let eps = T::default_epsilon();
-            let scale = q.amax().max(T::one());
-            eps * scale * scale + eps * nalgebra::convert(64.0) * p.qq.diagonal().amax()
+            let rounding = eps * nalgebra::convert(4.0) * q.amax().max(T::one());
+            let held =
+                p.qq.diagonal()
+                    .amax()
+                    .max(tau * tau * p.vv.diagonal().amax().max(s0 * s0));
+            rounding * rounding + eps * nalgebra::convert(64.0) * held
         };
         let mut relinearisations = 0;
         if let Some(unpredicted) = unpredicted {
@@ -828,9 +848,8 @@ where
         // GATE the innovation
         let y = q - q_pred;
         report.innovation = y;
-        // R, plus the rounding of a sample stored in T (ε|q|) and of the
-        // covariance itself (64 ε its largest variance), so that exact
-        // samples (R = 0) never leave S singular
+        // R plus the floor above, so that exact samples (R = 0) never
+        // leave S singular
         let floor = floor(&p);
         let mut outliers = self.outliers;
         let gate = self.params.gate;
