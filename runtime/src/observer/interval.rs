@@ -515,6 +515,13 @@ struct Classes<const K: usize> {
     elastic: IndexSet<K>,
     /// Closed, normal speed within the resting speed: persistent contact.
     sliding: IndexSet<K>,
+    /// Those of `sliding` that rest on their constraint, pushed onto it or
+    /// not: not grazed, and not accelerated off it within the interval
+    /// faster than the estimate's velocity noise (`α_i τ ≤ g_i u_v`, with
+    /// `α_i` the free normal acceleration, positive away). Glued bodies
+    /// in free flight are: no force holds them together, and none pulls
+    /// them apart.
+    resting: IndexSet<K>,
     /// Closed and separating: watched for a return.
     departing: IndexSet<K>,
 }
@@ -1125,6 +1132,11 @@ where
             } else if jw <= depart {
                 c.contact.insert(i);
                 c.sliding.insert(i);
+                // resting: the free motion does not leave it within the
+                // interval faster than the estimate's velocity noise
+                if alpha[i] * self.tau <= g * noise_speed + floor {
+                    c.resting.insert(i);
+                }
             } else {
                 if !bounced.contains(i) || held.contains(i) || jw <= rest + g * self.uncertainty {
                     c.contact.insert(i);

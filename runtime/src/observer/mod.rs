@@ -192,7 +192,13 @@
 //!   treated as open instead, so that its root along the prediction times
 //!   the impact (the band only says it is near);
 //! - a closed constraint with `|J_i w| ≤ v_rest` is a **persistent
-//!   contact** (sliding, resting), held at acceleration level;
+//!   contact** (sliding, resting), held at acceleration level; it is
+//!   **resting** unless grazed (below) or accelerated off its constraint
+//!   within the interval faster than the estimate's noise (`α_i τ ≤ g_i
+//!   ν`, `α_i` its free normal acceleration, positive away): the filter
+//!   keeps a resting contact on its manifold even where no force holds
+//!   it there (glued bodies in free flight), as it keeps one that a force
+//!   holds (module docs of `runtime/src/observer/kalman/mod.rs`);
 //! - a closed constraint separating faster than `v_rest` is **departing**:
 //!   free, but watched for a return within the interval; if it has just
 //!   bounced (in this interval or the last), it is left out of an impact

@@ -27,6 +27,9 @@ pub(crate) struct Flight<'a, T: RealField + Copy, const N: usize, const K: usize
     pub p1: &'a SVector<T, N>,
     pub w1: &'a SVector<T, N>,
     pub sliding: IndexSet<K>,
+    /// Those of `sliding` that rest on their constraint, whether or not a
+    /// force holds them there (the contact rule's `resting`).
+    pub resting: IndexSet<K>,
     pub impulse: &'a SVector<T, K>,
 }
 
@@ -187,6 +190,7 @@ where
                         p1: &part.p,
                         w1: &part.w,
                         sliding: c.sliding,
+                        resting: c.resting,
                         impulse: &part.impulse,
                     })?;
                     report.impulses += part.impulse;
@@ -203,6 +207,7 @@ where
                 p1: &arc.p,
                 w1: &arc.w,
                 sliding: c.sliding,
+                resting: c.resting,
                 impulse: &arc.impulse,
             })?;
             report.impulses += arc.impulse;

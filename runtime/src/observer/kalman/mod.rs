@@ -48,7 +48,8 @@
 //!      the constraints one at a time, the product of the single impacts'
 //!      `Ξ`, module `propagate`);
 //!    - a piece of persistent contact on the set `S` (the constraints whose
-//!      multiplier pushed along it): the Jacobian of the constrained flow
+//!      multiplier pushed along it, and those resting with no multiplier,
+//!      as glued bodies in free flight: `Interval::classify`): the Jacobian of the constrained flow
 //!      ([`constrained_flow_jacobian`]), `P ← Φ P Φᵀ + Q(h)`, then `P`
 //!      projected onto the tangent space of the contact manifold at the
 //!      end of the piece, `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
@@ -784,11 +785,13 @@ where
         // the floor under `R` in `S = P_qq + R`: the rounding of a
         // coordinate stored in `T` (a few units of `ε |q|`: the sample's
         // own and the prediction's), plus 64 ε times the largest variance
-        // the covariance holds or has held, in units of position (`P_qq`,
-        // and `τ² P_vv` with the initial `P_vv` as well: an update that
-        // pins the position down from exact samples leaves `P` with
-        // errors of ε times what it held before, and a posterior `P_qq`
-        // below them turns the velocity block indefinite). This is what
+        // in units of position that the covariance holds now (`P_qq`,
+        // `τ² P_vv`) or held at the start (`τ²` times the initial
+        // velocity variance: an update that pins the position down from
+        // exact samples leaves `P` with errors of ε times what it held
+        // before, and a posterior `P_qq` below them turns the velocity
+        // block indefinite; without this term, exact samples of the arm
+        // told `C_v` = 200 rad/s restarted it). This is what
         // keeps exact samples (`R = 0`) from driving `P` indefinite,
         // without adding noise that a real `R` already dominates: a
         // floor of `ε |q|²` (half the digits of a coordinate) did the

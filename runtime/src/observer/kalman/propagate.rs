@@ -323,10 +323,13 @@ where
     fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
         let w0 = saturate(piece.w0, self.bound);
         let t = self.t0 + piece.s0;
-        // the contacts that pushed along the piece
+        // the contacts that pushed along the piece, and those resting on
+        // it with no force (glued bodies in free flight: without the
+        // projection their relative velocity is only as well known as the
+        // samples make it, and the estimate takes them apart)
         let mut held = IndexSet::EMPTY;
         for i in piece.sliding.iter().filter(|&i| i < K) {
-            if piece.impulse[i] > T::zero() {
+            if piece.impulse[i] > T::zero() || piece.resting.contains(i) {
                 held.insert(i);
             }
         }
