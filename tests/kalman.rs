@@ -1432,7 +1432,7 @@ fn glued_balls_stay_glued_in_the_filter() {
 /// Four random starts (seed 31, none picked; joint speeds up to 57
 /// rad/s), 8 s each against the plant, scored from the first update on:
 /// no restart, no sample refused, medians ≤ 1e-8 and maxima ≤ 1e-3
-/// (measured: medians 3.9e-10 to 2.9e-9, maxima 1.0e-5 to 3.4e-4, the
+/// (measured: medians 3.7e-10 to 2.9e-9, maxima 1.0e-5 to 3.4e-4, the
 /// largest at the arm's impacts).
 #[test]
 fn exact_samples_and_a_generous_velocity_bound_do_not_wedge_the_filter() {

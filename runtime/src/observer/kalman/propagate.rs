@@ -50,7 +50,8 @@
 //! Newton's saltation is kept, an approximation. On the double pendulum's
 //! corner this took the filter's largest error in the accumulations from
 //! 7.7e-2 to 6.2e-3 rad/s (7.1e-3 since a constraint that has just
-//! bounced is left out of an impact on the others; `tests/kalman.rs`,
+//! bounced is left out of an impact on the others, 6.4e-3 since a
+//! resting contact with no force on it is held; `tests/kalman.rs`,
 //! `full_reach`).
 //!
 //! # The mean delay of an impact
