@@ -60,8 +60,9 @@
 //!      onto the manifold in the same metric. The contact force cancels
 //!      the normal motion, modelled and unmodelled; what stays uncertain
 //!      across the contact (its compliance, the plant's own penetration)
-//!      is the noise's position and velocity variances, added
-//!      uncorrelated: `P` stays positive definite, and a penetration seen
+//!      is the part of the noise's position and velocity variances that
+//!      the projection took, put back uncorrelated: `P` stays positive
+//!      definite, and a penetration seen
 //!      in exact samples moves the position estimate, not the velocity.
 //!
 //!    **Relinearised** on the first update after a start or a restart. Its
