@@ -49,7 +49,8 @@
 //!      `Ξ`, module `propagate`);
 //!    - a piece of persistent contact on the set `S` (the constraints whose
 //!      multiplier pushed along it, and those resting with no multiplier,
-//!      as glued bodies in free flight: `Interval::classify`): the Jacobian of the constrained flow
+//!      as glued bodies in free flight: `Interval::classify`): the
+//!      Jacobian of the constrained flow
 //!      ([`constrained_flow_jacobian`]), `P ← Φ P Φᵀ + Q(h)`, then `P`
 //!      projected onto the tangent space of the contact manifold at the
 //!      end of the piece, `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
@@ -62,8 +63,8 @@
 //!      across the contact (its compliance, the plant's own penetration)
 //!      is the part of the noise's position and velocity variances that
 //!      the projection took, put back uncorrelated: `P` stays positive
-//!      definite, and a penetration seen
-//!      in exact samples moves the position estimate, not the velocity.
+//!      definite, and a penetration seen in exact samples moves the
+//!      position estimate, not the velocity.
 //!
 //!    **Relinearised** on the first update after a start or a restart. Its
 //!    prior velocity is a guess (`v̂(0)`, or a restart's mean velocity)
