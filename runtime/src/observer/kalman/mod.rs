@@ -787,28 +787,26 @@ where
         // the floor under `R` in `S = P_qq + R`: the rounding of a
         // coordinate stored in `T` (a few units of `ε |q|`: the sample's
         // own and the prediction's), plus 64 ε times the largest variance
-        // in units of position that the covariance holds now (`P_qq`,
-        // `τ² P_vv`) or held at the start (`τ²` times the initial
-        // velocity variance: an update that pins the position down from
-        // exact samples leaves `P` with errors of ε times what it held
-        // before, and a posterior `P_qq` below them turns the velocity
-        // block indefinite; without this term, exact samples of the arm
-        // told `C_v` = 200 rad/s restarted it). This is what
-        // keeps exact samples (`R = 0`) from driving `P` indefinite,
-        // without adding noise that a real `R` already dominates: a
-        // floor of `ε |q|²` (half the digits of a coordinate) did the
-        // same but is `√ε |q|` = 1.7e-3 m at `|q|` = 5 in `f32`, and held
-        // the `f32` filter at σ = 1e-4 seven to ten times above the `f64`
-        // one (`tests/kalman.rs`, `runs_in_f32`)
+        // in units of position that the covariance holds (`P_qq`,
+        // `τ² P_vv`), so that exact samples (`R = 0`) never leave `S`
+        // singular, without adding noise that a real `R` already
+        // dominates. A floor of `ε |q|²` (half the digits of a coordinate)
+        // is `√ε |q|` = 1.7e-3 m at `|q|` = 5 in `f32`, and held the `f32`
+        // filter at σ = 1e-4 seven to ten times above the `f64` one
+        // (`tests/kalman.rs`, `runs_in_f32`). A third term, 64 ε times
+        // the initial velocity variance times `τ²`, stood in for the
+        // rounding of the first updates from a diffuse prior until every
+        // congruence covered its own (`Blocks::congruence_covered`); in
+        // `f32` it treated exact samples as noisy to 5.5e-5 m for the
+        // whole run (`exact_samples_keep_the_covariance_positive_in_f32`)
         let tau = interval.tau;
-        let s0 = self.params.initial_velocity_sigma;
         let floor = |p: &Blocks<T, N>| {
             let eps = T::default_epsilon();
             let rounding = eps * nalgebra::convert(4.0) * q.amax().max(T::one());
             let held =
                 p.qq.diagonal()
                     .amax()
-                    .max(tau * tau * p.vv.diagonal().amax().max(s0 * s0));
+                    .max(tau * tau * p.vv.diagonal().amax());
             rounding * rounding + eps * nalgebra::convert(64.0) * held
         };
         let mut relinearisations = 0;
@@ -930,7 +928,7 @@ where
                 vq: -k_v,
                 vv: id,
             };
-            let joseph = b.congruence(&p);
+            let joseph = b.congruence_covered(&p);
             let noise = Blocks {
                 qq: k_q * r * k_q.transpose(),
                 qv: k_q * r * k_v.transpose(),

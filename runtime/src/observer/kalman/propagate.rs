@@ -342,7 +342,7 @@ where
         self.held = held;
         let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
         let phi = transition(&a, piece.h);
-        let mut p = phi.congruence(&self.p).add(&noise);
+        let mut p = phi.congruence_covered(&self.p).add(&noise);
         self.carry_offset(&phi);
         self.correction = (SVector::zeros(), SVector::zeros());
         if !held.is_empty() {
@@ -442,7 +442,11 @@ where
         // start of a piece has neither)
         let timed = guard.is_some();
         let noise = self.impact_noise(&s, timed, jump.p, &w)?;
-        self.p = s.matrix.congruence(&self.p).add(&noise).symmetrized();
+        self.p = s
+            .matrix
+            .congruence_covered(&self.p)
+            .add(&noise)
+            .symmetrized();
         self.carry_offset(&s.matrix);
         if timed && self.delay != T::zero() {
             self.offset.0 += s.timing.0 * self.delay;

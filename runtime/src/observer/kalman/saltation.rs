@@ -527,7 +527,7 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
     let dq = -(pinv * r_h);
     let dv = -(pinv * (j * v + d * dq));
     Some(Projection {
-        p: b.congruence(p),
+        p: b.congruence_covered(p),
         map: b,
         dq,
         dv,
