@@ -375,6 +375,25 @@ struct Point<'a, T: RealField + Copy, const N: usize> {
     free: &'a Free<T, N>,
 }
 
+/// The impact law that gave `w⁺` at a [`Jump`] (the contact rule in
+/// `runtime/src/observer/mod.rs`), so that the filter maps its covariance
+/// through that law's saltation matrix rather than guess the law from
+/// `w⁺`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Law<T> {
+    /// Newton's law on the set, each constraint with its own restitution
+    /// (the LCP's outcome).
+    Newton,
+    /// Moreau's law with the one restitution `e` (the least of the set),
+    /// where Newton's would have put energy in ([`gains_energy`]): on the
+    /// constraints that take an impulse, Newton's law with `e` on each.
+    Moreau(T),
+    /// The constraints met one at a time, the fastest approach first
+    /// ([`Interval::one_at_a_time`]): opposed gradients ([`opposed`]), or
+    /// no solution in floating point.
+    OneAtATime,
+}
+
 /// Where Newton's law acts: local time `s`, the pre-impact velocity `w`,
 /// and `J`, `M` (factored) evaluated there.
 #[derive(Clone, Copy)]
@@ -692,7 +711,7 @@ where
         set: IndexSet<K>,
         elastic: IndexSet<K>,
         report: &mut UpdateReport<T, N, K>,
-    ) -> Result<SVector<T, N>, T> {
+    ) -> Result<(SVector<T, N>, Law<T>), T> {
         let Contact { s, w, jac, chol } = *at;
         let jw = jac * w;
         // the restitution each constraint of the set takes: `ê_i` if elastic
@@ -701,14 +720,15 @@ where
             e[i] = self.restitution[i];
         }
         let before = report.impulses;
-        let dv = match self.impulse(jac, chol, w, &e.component_mul(&jw), set, report) {
+        let (dv, law) = match self.impulse(jac, chol, w, &e.component_mul(&jw), set, report) {
             Ok(dv) if set.len() > 1 => self.checked(at, (set, &e, &jw), before, dv, report)?,
-            Ok(dv) => dv,
+            Ok(dv) => (dv, Law::Newton),
             // gradients nearly dependent (see `opposed`) can leave the
             // problem without a solution in floating point
             Err(_) if set.len() > 1 => {
                 let minv_jt = chol.solve(&jac.transpose());
-                self.one_at_a_time(at, &minv_jt, set, &e, report)
+                let dv = self.one_at_a_time(at, &minv_jt, set, &e, report);
+                (dv, Law::OneAtATime)
             }
             Err(e) => return Err(e),
         };
@@ -722,7 +742,7 @@ where
         } else {
             report.contacts = report.contacts.union(set);
         }
-        Ok(w + dv)
+        Ok((w + dv, law))
     }
 
     /// Newton's law on several constraints (`set`, restitutions `e`,
@@ -732,7 +752,8 @@ where
     /// takes its place; where the closure is of nearly opposite
     /// constraints ([`opposed`]), the constraints are met one at a time
     /// ([`one_at_a_time`](Self::one_at_a_time)). The impulses recorded
-    /// since `before` are those of the law kept.
+    /// since `before` are those of the law kept, which is returned with
+    /// `dv`.
     fn checked(
         &self,
         at: &Contact<'_, T, N, K>,
@@ -740,8 +761,9 @@ where
         before: SVector<T, K>,
         mut dv: SVector<T, N>,
         report: &mut UpdateReport<T, N, K>,
-    ) -> Result<SVector<T, N>, T> {
+    ) -> Result<(SVector<T, N>, Law<T>), T> {
         let Contact { w, jac, chol, .. } = *at;
+        let mut law = Law::Newton;
         if gains_energy(&(report.impulses - before), jw, &(jac * (w + dv))) {
             let least = set.iter().fold(T::one(), |least, i| least.min(e[i]));
             report.impulses = before;
@@ -749,14 +771,16 @@ where
             let scale = T::one() + least;
             report.impulses = before + (report.impulses - before) * scale;
             dv = plastic * scale;
+            law = Law::Moreau(least);
         }
         let minv_jt = chol.solve(&jac.transpose());
         let lambda = report.impulses - before;
         if opposed(set, &lambda, jw, &(jac * (w + dv)), &(jac * minv_jt)) {
             report.impulses = before;
             dv = self.one_at_a_time(at, &minv_jt, set, e, report);
+            law = Law::OneAtATime;
         }
-        Ok(dv)
+        Ok((dv, law))
     }
 
     /// Newton's law on the constraints of `set` (restitutions `e`) one at
@@ -1488,7 +1512,7 @@ where
             jac: &jac,
             chol: &free.chol,
         };
-        self.newton(&at, c.contact, c.elastic, report)
+        Ok(self.newton(&at, c.contact, c.elastic, report)?.0)
     }
 }
 

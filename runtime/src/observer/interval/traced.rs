@@ -13,7 +13,8 @@ use crate::lcp::IndexSet;
 use crate::model::Model;
 
 use super::{
-    Contact, Crossing, Free, Interval, Path, Point, Result, Segment, UpdateReport, check_contact,
+    Contact, Crossing, Free, Interval, Law, Path, Point, Result, Segment, UpdateReport,
+    check_contact,
 };
 
 /// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
@@ -42,11 +43,11 @@ pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> 
     pub s: T,
     pub p: &'a SVector<T, N>,
     pub w_minus: &'a SVector<T, N>,
-    /// The post-impact velocity the law gave: Newton's with the LCP, or,
-    /// where that would put energy in or the constraints oppose, Moreau's
-    /// or one constraint at a time (the contact rule in
+    /// The law that gave the post-impact velocity: Newton's with the LCP,
+    /// or, where that would put energy in or the constraints oppose,
+    /// Moreau's or one constraint at a time (the contact rule in
     /// `runtime/src/observer/mod.rs`).
-    pub w_plus: &'a SVector<T, N>,
+    pub law: Law<T>,
     pub lambda: &'a SVector<T, K>,
     pub set: IndexSet<K>,
     pub elastic: IndexSet<K>,
@@ -132,7 +133,7 @@ where
                     jac: &jac,
                     chol: &free.chol,
                 };
-                let w_plus = self.newton(&at, c.contact, elastic, report)?;
+                let (w_plus, law) = self.newton(&at, c.contact, elastic, report)?;
                 let lambda = report.impulses - before;
                 for i in elastic {
                     if lambda[i] > T::zero() {
@@ -143,7 +144,7 @@ where
                     s,
                     p: &p,
                     w_minus: &w,
-                    w_plus: &w_plus,
+                    law,
                     lambda: &lambda,
                     set: c.contact,
                     elastic,
