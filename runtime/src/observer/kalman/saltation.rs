@@ -483,7 +483,8 @@ pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
 ///
 /// a projector (`B² = B`) whose range satisfies `J_S δq = 0` and
 /// `D δq + J_S δv = 0`; `P ← B P Bᵀ` (a congruence: positive
-/// semi-definite whatever the round-off of `P`). The state moves onto the
+/// semi-definite, its own rounding covered by
+/// [`Blocks::congruence_covered`]). The state moves onto the
 /// manifold along the same metric: `δq = −J⁺ h_S`, then
 /// `δv = −J⁺ (J_S v + D δq)`. Returns `None` when the rows of `set` are
 /// dependent.
