@@ -320,7 +320,7 @@ where
     // the impact the finite differences see: the LCP's active set
     let (x_minus, t_hit) = flow_to_guard::<M, N, K>(model, u, &x0, guard);
     let (q_hit, v_hit) = unstack::<N>(&x_minus);
-    let (_, lambda) = newton_reset::<M, N, K>(model, &q_hit, &v_hit, set, &e);
+    let (v_plus, lambda) = newton_reset::<M, N, K>(model, &q_hit, &v_hit, set, &e);
     assert!(
         lambda.iter().any(|&l| l > 0.0),
         "{}: no impulse, no impact",
@@ -339,10 +339,7 @@ where
         Some(guard),
     )
     .unwrap();
-    let x_plus = stack(
-        &q_hit,
-        &newton_reset::<M, N, K>(model, &q_hit, &v_hit, set, &e).0,
-    );
+    let x_plus = stack(&q_hit, &v_plus);
     let total = jacobian_fd(
         |x| flow_impact_flow::<M, N, K>(model, u, x, guard, set, &e, 2.0 * delta),
         &x0,

@@ -63,7 +63,7 @@ pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> 
 pub(crate) trait Tracer<T: RealField + Copy, const N: usize, const K: usize> {
     /// A piece of flight (or sliding) was integrated.
     fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T>;
-    /// Newton's law was applied.
+    /// An impact law was applied (which one: [`Jump::law`]).
     fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T>;
 }
 
