@@ -163,6 +163,26 @@ where
             if rest <= T::zero() {
                 return Ok((p, w));
             }
+            // SETTLE (the filter): the held constraints' separating normal
+            // speed out, so that the force that holds them does no work
+            let settled = if self.settle_held {
+                self.settled(&point, &jac, c.sliding, report)?
+            } else {
+                None
+            };
+            let free = match settled {
+                Some(settled) => {
+                    w = settled;
+                    self.free(s, &p, &w, report)?
+                }
+                None => free,
+            };
+            let point = Point {
+                s,
+                p: &p,
+                w: &w,
+                free: &free,
+            };
             let arc = self.advance(&point, rest, c.sliding, report)?;
             report.contacts = report.contacts.union(c.sliding);
             // SEARCH for the first closing constraint along it
