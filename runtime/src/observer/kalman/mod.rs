@@ -64,7 +64,12 @@
 //!      is the part of the noise's position and velocity variances that
 //!      the projection took, put back uncorrelated: `P` stays positive
 //!      definite, and a penetration seen in exact samples moves the
-//!      position estimate, not the velocity.
+//!      position estimate, not the velocity. The piece starts with the
+//!      separating normal speed of the held constraints that push taken
+//!      out in the same metric (`Interval::settled`), so the force that
+//!      holds them does no work on an estimate leaving them: the
+//!      prediction never gains energy from a contact (`tests/kalman.rs`,
+//!      `a_held_contact_does_no_work_on_a_separating_estimate`).
 //!
 //!    **Relinearised** on the first update after a start or a restart. Its
 //!    prior velocity is a guess (`v̂(0)`, or a restart's mean velocity)
