@@ -919,7 +919,9 @@ where
     /// with `S` the constraints of `sliding` that `w` leaves (`J_i w > 0`)
     /// while their acceleration-level law pushes (`λ_i > 0` at `(p, w)`),
     /// `w − M⁻¹J_Sᵀ (J_S M⁻¹J_Sᵀ)⁻¹ J_S w`; `None` when there is no such
-    /// constraint (or their rows are dependent).
+    /// constraint, when their rows are dependent, or when rounding made
+    /// the result's kinetic energy larger than `w`'s (the projection
+    /// cannot, in exact arithmetic).
     ///
     /// Why: the contact rule holds a closed constraint that separates
     /// slower than its resting speed (it cannot tell that from noise on a
@@ -984,7 +986,16 @@ where
                 delassus[(a, b)] = (jmj[(a, b)] + jmj[(b, a)]) * half;
             }
         }
-        Ok(Ldlt::new(&delassus).map(|d| w - minv_jt * d.solve(&speed)))
+        let Some(delassus) = Ldlt::new(&delassus) else {
+            return Ok(None);
+        };
+        let settled = w - minv_jt * delassus.solve(&speed);
+        // the projection cannot raise the kinetic energy; where rounding
+        // in a nearly singular `J_S M⁻¹J_Sᵀ` made it, keep `w`
+        let mass = self.model.mass(at.p);
+        let energy = |v: &SVector<T, N>| v.dot(&(mass * v));
+        let slack = T::one() + T::default_epsilon() * nalgebra::convert(64.0);
+        Ok((energy(&settled) <= energy(w) * slack).then_some(settled))
     }
 
     /// The acceleration with the persistent contacts `sliding` held by
