@@ -1134,9 +1134,11 @@ where
     /// Constraints `touched` (reached by a root here) and `held` (held
     /// along the piece that led here) are closed whatever the sign of
     /// their gap: a held contact keeps the normal speed the rule took for
-    /// rest, and drifts by it (on exact samples of the billiard, 8e-9 m
-    /// in 0.8 ms), so that a band of zero would read it open at the next
-    /// event and resolve an impact on another constraint without it.
+    /// rest (in the observers; the filter takes a separating one out where
+    /// the contact pushes, [`settled`](Self::settled)), and drifts by it
+    /// (on exact samples of the billiard, 8e-9 m in 0.8 ms), so that a
+    /// band of zero would read it open at the next event and resolve an
+    /// impact on another constraint without it.
     ///
     /// A closed constraint that may have just bounced (an elastic impulse
     /// earlier in the interval, or any impulse in the last update's:
