@@ -8,7 +8,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::{IndexSet, Lcp};
-use crate::linalg::Ldlt;
+use crate::linalg::{Ldlt, OnSet};
 use crate::model::Model;
 
 use super::{ObserverError, ObserverParams, UpdateReport, check_update};
@@ -917,7 +917,8 @@ where
     /// The velocity `w` with the separating normal speed of the held
     /// constraints that push taken out, in the metric of the mass matrix:
     /// with `S` the constraints of `sliding` that `w` leaves (`J_i w > 0`)
-    /// while their acceleration-level law pushes (`λ_i > 0` at `(p, w)`),
+    /// while their acceleration-level law pushes (`lambda_i > 0`, the
+    /// multipliers at `(p, w)`: the piece's first Runge–Kutta stage),
     /// `w − M⁻¹J_Sᵀ (J_S M⁻¹J_Sᵀ)⁻¹ J_S w`; `None` when there is no such
     /// constraint, when their rows are dependent, or when rounding made
     /// the result's kinetic energy larger than `w`'s (the projection
@@ -950,52 +951,31 @@ where
         at: &Point<'_, T, N>,
         jac: &SMatrix<T, K, N>,
         sliding: IndexSet<K>,
-        report: &mut UpdateReport<T, N, K>,
-    ) -> Result<Option<SVector<T, N>>, T> {
+        lambda: &SVector<T, K>,
+    ) -> Option<SVector<T, N>> {
         let w = at.w;
-        let mut separating = IndexSet::<K>::EMPTY;
-        for i in sliding.iter().filter(|&i| i < K) {
-            if jac.row(i).dot(&w.transpose()) > T::zero() {
-                separating.insert(i);
-            }
-        }
-        if separating.is_empty() {
-            return Ok(None);
-        }
-        let (_, lambda) = self.constrained(at.p, w, sliding, at.free, report)?;
-        let mut j = SMatrix::<T, K, N>::zeros();
-        let mut speed = SVector::<T, K>::zeros();
         let mut set = IndexSet::<K>::EMPTY;
-        for i in separating
-            .iter()
-            .filter(|&i| i < K && lambda[i] > T::zero())
-        {
-            set.insert(i);
-            j.set_row(i, &jac.row(i));
-            speed[i] = jac.row(i).dot(&w.transpose());
+        let mut speed = SVector::<T, K>::zeros();
+        for i in sliding.iter().filter(|&i| i < K && lambda[i] > T::zero()) {
+            let jw = jac.row(i).dot(&w.transpose());
+            if jw > T::zero() {
+                set.insert(i);
+                speed[i] = jw;
+            }
         }
         if set.is_empty() {
-            return Ok(None);
+            return None;
         }
-        let minv_jt = at.free.chol.solve(&j.transpose());
-        let jmj = j * minv_jt;
-        let half: T = nalgebra::convert(0.5);
-        let mut delassus = SMatrix::<T, K, K>::identity();
-        for a in set.iter().filter(|&i| i < K) {
-            for b in set.iter().filter(|&i| i < K) {
-                delassus[(a, b)] = (jmj[(a, b)] + jmj[(b, a)]) * half;
-            }
-        }
-        let Some(delassus) = Ldlt::new(&delassus) else {
-            return Ok(None);
-        };
-        let settled = w - minv_jt * delassus.solve(&speed);
+        let OnSet {
+            minv_jt, delassus, ..
+        } = OnSet::new(jac, &at.free.chol, set);
+        let settled = w - minv_jt * delassus?.solve(&speed);
         // the projection cannot raise the kinetic energy; where rounding
         // in a nearly singular `J_S M⁻¹J_Sᵀ` made it, keep `w`
         let mass = self.model.mass(at.p);
         let energy = |v: &SVector<T, N>| v.dot(&(mass * v));
         let slack = T::one() + T::default_epsilon() * nalgebra::convert(64.0);
-        Ok((energy(&settled) <= energy(w) * slack).then_some(settled))
+        (energy(&settled) <= energy(w) * slack).then_some(settled)
     }
 
     /// The acceleration with the persistent contacts `sliding` held by
@@ -1029,7 +1009,8 @@ where
     }
 
     /// The motion over `[s0, s0 + h]` from `start`, with the persistent
-    /// contacts `sliding` held: [`rk4`](Self::rk4). In free flight under a
+    /// contacts `sliding` held, `first` the first stage at `start`
+    /// ([`rk4`](Self::rk4)). In free flight under a
     /// constant acceleration `a` (the interval's `constant`) the four
     /// stages all take `a`, and the same arithmetic is done here, inlined,
     /// without the calls for the stages (the same bits: `tests/memo.rs`).
@@ -1039,10 +1020,11 @@ where
         start: &Point<'_, T, N>,
         h: T,
         sliding: IndexSet<K>,
+        first: &(SVector<T, N>, SVector<T, K>),
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Arc<T, N, K>, T> {
         if !(sliding.is_empty() && self.constant.is_some()) {
-            return self.rk4(start, h, sliding, report);
+            return self.rk4(start, h, sliding, first, report);
         }
         // the three further stages' points, served by the memo
         report.evaluations += 3;
@@ -1061,12 +1043,15 @@ where
 
     /// Classical fourth-order Runge–Kutta for `p' = w`, `w' = a(s, p, w)`
     /// over `[s0, s0 + h]` from `start`, with the persistent contacts
-    /// `sliding` held.
+    /// `sliding` held; `stage` is the acceleration and the multipliers at
+    /// `start` ([`constrained`](Self::constrained)), computed once by the
+    /// caller for every piece that starts there.
     fn rk4(
         &self,
         start: &Point<'_, T, N>,
         h: T,
         sliding: IndexSet<K>,
+        stage: &(SVector<T, N>, SVector<T, K>),
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Arc<T, N, K>, T> {
         let Point {
@@ -1093,7 +1078,7 @@ where
                 impulse: SVector::zeros(),
             });
         }
-        let (k1, l1) = self.constrained(p0, w0, sliding, first, report)?;
+        let (k1, l1) = *stage;
         let (p2, w2) = (p0 + w0 * half, w0 + k1 * half);
         let f2 = self.free(s0 + half, &p2, &w2, report)?;
         let (k2, l2) = self.constrained(&p2, &w2, sliding, &f2, report)?;

@@ -163,17 +163,22 @@ where
             if rest <= T::zero() {
                 return Ok((p, w));
             }
+            // the held contacts' acceleration and force at the start, the
+            // first Runge–Kutta stage of every piece from here
+            let mut stage = self.constrained(&p, &w, c.sliding, &free, report)?;
             // SETTLE (the filter): the held constraints' separating normal
-            // speed out, so that the force that holds them does no work
+            // speed out where they push, so that their force does no work
             let settled = if self.settle_held {
-                self.settled(&point, &jac, c.sliding, report)?
+                self.settled(&point, &jac, c.sliding, &stage.1)
             } else {
                 None
             };
             let free = match settled {
                 Some(settled) => {
                     w = settled;
-                    self.free(s, &p, &w, report)?
+                    let free = self.free(s, &p, &w, report)?;
+                    stage = self.constrained(&p, &w, c.sliding, &free, report)?;
+                    free
                 }
                 None => free,
             };
@@ -183,7 +188,7 @@ where
                 w: &w,
                 free: &free,
             };
-            let arc = self.advance(&point, rest, c.sliding, report)?;
+            let arc = self.advance(&point, rest, c.sliding, &stage, report)?;
             report.contacts = report.contacts.union(c.sliding);
             // SEARCH for the first closing constraint along it
             if !last_round && report.impacts < max_impacts {
@@ -202,7 +207,7 @@ where
                 if let Some(Crossing { at, set }) =
                     self.first_crossing(&seg, &c, (&jac, band), (&h, &rate0), (&h1, &rate1))?
                 {
-                    let part = self.advance(&point, at, c.sliding, report)?;
+                    let part = self.advance(&point, at, c.sliding, &stage, report)?;
                     tracer.flight(&Flight {
                         s0: s,
                         h: at,

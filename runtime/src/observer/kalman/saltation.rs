@@ -8,7 +8,7 @@
 use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::IndexSet;
-use crate::linalg::Ldlt;
+use crate::linalg::{Ldlt, OnSet};
 use crate::model::Sensitivities;
 
 use super::super::ObserverError;
@@ -149,20 +149,12 @@ where
     // λ on the active rows; drop those that pull, once
     let mut solved = None;
     for _ in 0..2 {
-        let mut jac_a = SMatrix::<T, K, N>::zeros();
-        let mut w = SMatrix::<T, K, K>::identity();
-        for i in active {
-            jac_a.set_row(i, &jac.row(i));
-        }
-        let minv_jt = chol.solve(&jac_a.transpose());
-        let jmj = jac_a * minv_jt;
-        for i in active {
-            for j in active {
-                w[(i, j)] = jmj[(i, j)];
-            }
-        }
-        let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
-        let Some(w_chol) = Ldlt::new(&w) else {
+        let OnSet {
+            rows: jac_a,
+            minv_jt,
+            delassus,
+        } = OnSet::new(&jac, &chol, active);
+        let Some(w_chol) = delassus else {
             break;
         };
         let mut rhs = -(jac_a * free);
@@ -378,22 +370,16 @@ where
     let (_, jac) = model.contact(q);
     finite(&jac, "J")?;
     // rows off the active set are zero, and W gets 1 on their diagonal
-    let mut jac_a = SMatrix::<T, K, N>::zeros();
-    let mut w = SMatrix::<T, K, K>::zeros();
     let mut e_a = SVector::<T, K>::zeros();
     for i in active.iter().filter(|&i| i < K) {
-        jac_a.set_row(i, &jac.row(i));
         e_a[i] = e[i];
     }
-    let minv_jt = chol.solve(&jac_a.transpose());
-    w += jac_a * minv_jt;
-    for i in 0..K {
-        if !active.contains(i) {
-            w[(i, i)] = T::one();
-        }
-    }
-    let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
-    let w_chol = Ldlt::new(&w).ok_or(ObserverError::Data(DataError::InvalidParams {
+    let OnSet {
+        rows: jac_a,
+        minv_jt,
+        delassus,
+    } = OnSet::new(&jac, &chol, active);
+    let w_chol = delassus.ok_or(ObserverError::Data(DataError::InvalidParams {
         name: "active",
         value: T::zero(),
     }))?;
@@ -498,24 +484,18 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
     v: &SVector<T, N>,
     set: IndexSet<K>,
 ) -> Option<Projection<T, N>> {
-    let mut j = SMatrix::<T, K, N>::zeros();
     let mut d = SMatrix::<T, K, N>::zeros();
-    let mut w = SMatrix::<T, K, K>::identity();
     let mut r_h = SVector::<T, K>::zeros();
     for i in set.iter().filter(|&i| i < K) {
-        j.set_row(i, &jac.row(i));
         d.set_row(i, &rate.row(i));
         r_h[i] = h[i];
     }
-    let minv_jt = mass.solve(&j.transpose());
-    let jmj = j * minv_jt;
-    for a in set.iter().filter(|&i| i < K) {
-        for b in set.iter().filter(|&i| i < K) {
-            w[(a, b)] = jmj[(a, b)];
-        }
-    }
-    let w = (w + w.transpose()) * nalgebra::convert::<f64, T>(0.5);
-    let w_chol = Ldlt::new(&w)?;
+    let OnSet {
+        rows: j,
+        minv_jt,
+        delassus,
+    } = OnSet::new(jac, mass, set);
+    let w_chol = delassus?;
     // J⁺ = M⁻¹Jᵀ W⁻¹ (N × K)
     let pinv = w_chol.solve(&minv_jt.transpose()).transpose();
     let pi = SMatrix::<T, N, N>::identity() - pinv * j;
