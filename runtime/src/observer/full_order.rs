@@ -447,7 +447,6 @@ where
             restitution: self.restitution.as_ref(),
             report: &self.report,
             release_departures: false,
-            settle_held: false,
         };
         let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN: an outlier is refused here, the estimate untouched

@@ -166,14 +166,9 @@ where
             // the held contacts' acceleration and force at the start, the
             // first Runge–Kutta stage of every piece from here
             let mut stage = self.constrained(&p, &w, c.sliding, &free, report)?;
-            // SETTLE (the filter): the held constraints' separating normal
-            // speed out where they push, so that their force does no work
-            let settled = if self.settle_held {
-                self.settled(&point, &jac, c.sliding, &stage.1)
-            } else {
-                None
-            };
-            let free = match settled {
+            // SETTLE: the held constraints' separating normal speed out
+            // where they push, so that their force does no work
+            let free = match self.settled(&point, &jac, c.sliding, &stage.1) {
                 Some(settled) => {
                     w = settled;
                     let free = self.free(s, &p, &w, report)?;

@@ -753,7 +753,6 @@ where
             restitution: self.restitution.as_ref(),
             report: &self.report,
             release_departures: false,
-            settle_held: true,
         };
         let (mut interval, mut report) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN, as the observers do: a sample farther than the system
