@@ -104,7 +104,11 @@ fn check<M, const N: usize, const K: usize>(
 /// after an impact of the accumulation. Before these two changes (the
 /// smoothed position alone): median 1.23e-3 to 1.90e-3, 90th percentile
 /// 2.31e-3 to 3.59e-3, and without the bracketing samples up to 0.27 m/s
-/// (above 0.1 on 5 runs of 12).
+/// (above 0.1 on 5 runs of 12). Since held contacts start each piece
+/// settled (`Interval::settled`): median 1.10e-3 to 1.25e-3 (0.78 to
+/// 0.88 ×), 90th percentile 2.30e-3 to 2.61e-3 (1.63 to 1.85 ×), and
+/// without the bracketing samples the same 4.8e-3 to 0.098 m/s (worst per
+/// start 0.098, 0.050, 0.0055, 0.054).
 ///
 /// Asserted on every run: median and 90th percentile within the baseline's
 /// worst (`1.4` and `3` × √2 l_d σ), and without the bracketing samples a

@@ -1379,7 +1379,7 @@ fn glued_balls_hit_the_wall_together_in_both_observers() {
 /// `ε₃₂ t ≈ 1e-6 s`, a relative error of 1e-3 on a 1 ms interval; times the
 /// velocity (about 10 m/s) and the injection (l_d τ = 1e-2 per sample)
 /// that is an error of up to 1e-4 m/s per sample (measured medians over
-/// [2, 10] s: 3.6e-5 reduced, 4.2e-5 full); the median must stay below
+/// [2, 10] s: 2.8e-5 reduced, 2.4e-5 full); the median must stay below
 /// 1e-3 and the error must still converge from v̂(0) = 0 (below 1e-2 m/s
 /// at 2 s, from 9.5 m/s).
 #[test]
