@@ -446,7 +446,7 @@ where
             q: self.q,
             restitution: self.restitution.as_ref(),
             report: &self.report,
-            release_departures: false,
+            release_departures: true,
         };
         let (interval, fresh) = Interval::begin(model, u, memory, &mut self.cache, t, q)?;
         // SCREEN: an outlier is refused here, the estimate untouched

@@ -619,9 +619,12 @@ where
     /// fall term bounds how fast a sample that noise put outside the band
     /// falls back in; a separation is no such fall, and held at
     /// acceleration level it keeps its normal speed over the whole
-    /// interval instead of losing `A_i τ` of it. The same rule when
-    /// `σ = 0` (the band is then `d` alone). From [`Memory`]: set by the
-    /// reduced-order observer.
+    /// interval instead of losing `A_i τ` of it; and since a held
+    /// contact starts each piece settled ([`settled`](Self::settled)),
+    /// held it would lose the whole of it, where the plant still
+    /// bounces. The same rule when `σ = 0` (the band is then `d` alone).
+    /// From [`Memory`]: set by the observers (36) and (38), not by the
+    /// filter (whose band is its own position deviation, far below `σ`).
     pub release_departures: bool,
     /// The constraints given an impulse in the last update's interval
     /// (from [`Memory`]): with the bounces of this one, those that may

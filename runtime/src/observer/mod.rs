@@ -210,14 +210,14 @@
 //!   free, but watched for a return within the interval; if it has just
 //!   bounced (in this interval or the last), it is left out of an impact
 //!   on the other constraints (if their impulse turns it back, its root
-//!   times its own impact, as the plant meets it). For the
-//!   reduced-order observer (38) the separating speed is compared with
+//!   times its own impact, as the plant meets it). For the observers
+//!   (36) and (38) the separating speed is compared with
 //!   `v_rest` without its band term `√(4 A_i g_i b)` (that term bounds a
 //!   sample falling back into the band, not a separation, and a slow
-//!   separation held as a persistent contact keeps its normal speed over
-//!   the whole interval instead of losing `A_i τ` of it): under noise a
-//!   rebound of a few tenths of a m/s in an accumulation flies and
-//!   decelerates instead of keeping its speed for an interval (one
+//!   separation held as a persistent contact would lose all of its
+//!   normal speed to the settle where the plant still bounces): under
+//!   noise a rebound of a few hundredths to tenths of a m/s in an
+//!   accumulation flies and decelerates instead (one
 //!   departing slower than `v_rest` with the band term plus the
 //!   estimate's uncertainty, or held along the piece before, still takes
 //!   part in an impact on the others). With
