@@ -617,12 +617,12 @@ where
     /// `√(4 A_i g_i b)` is departing (free, watched for a return) instead
     /// of a persistent contact (`false` from [`begin`](Self::begin)). The
     /// fall term bounds how fast a sample that noise put outside the band
-    /// falls back in; a separation is no such fall, and held at
-    /// acceleration level it keeps its normal speed over the whole
-    /// interval instead of losing `A_i τ` of it; and since a held
-    /// contact starts each piece settled ([`settled`](Self::settled)),
-    /// held it would lose the whole of it, where the plant still
-    /// bounces. The same rule when `σ = 0` (the band is then `d` alone).
+    /// falls back in. A separation is no such fall, and a held contact
+    /// starts each piece settled ([`settled`](Self::settled)): held, a
+    /// real bounce would lose the whole of its normal speed. (Before the
+    /// settle it kept that speed over the whole interval instead of
+    /// losing `A_i τ` of it.) The same rule when `σ = 0` (the band is
+    /// then `d` alone).
     /// From [`Memory`]: set by the observers (36) and (38), not by the
     /// filter (whose band is its own position deviation, far below `σ`).
     pub release_departures: bool,
