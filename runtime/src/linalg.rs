@@ -145,6 +145,21 @@ impl<T: RealField + Copy, const N: usize> Ldlt<T, N> {
         Some(Self { f })
     }
 
+    /// `xᵀ A x` from the factor, `Σ d_i (Lᵀ x)_i²`: the kinetic energy
+    /// (twice it) of a velocity when `A` is the mass matrix, without
+    /// evaluating `M` again.
+    pub fn quadratic_form(&self, x: &SVector<T, N>) -> T {
+        let mut sum = T::zero();
+        for i in 0..N {
+            let mut y = x[i];
+            for k in i + 1..N {
+                y += self.f[(k, i)] * x[k];
+            }
+            sum += self.f[(i, i)] * y * y;
+        }
+        sum
+    }
+
     /// `A⁻¹ b`, column by column: `L y = b`, `z = D⁻¹ y`, `Lᵀ x = z`.
     pub fn solve<const C: usize>(&self, b: &SMatrix<T, N, C>) -> SMatrix<T, N, C> {
         let mut x = *b;
@@ -365,6 +380,16 @@ mod tests {
         let ours = Ldlt::new(&a).unwrap().solve(&rhs);
         let theirs = nalgebra::Cholesky::new(a).unwrap().solve(&rhs);
         assert!((ours - theirs).amax() <= 1e-12 * theirs.amax());
+    }
+
+    #[test]
+    fn ldlt_quadratic_form_is_x_a_x() {
+        let b = SMatrix::<f64, 5, 5>::from_fn(|i, j| ((i * 5 + j * 2) as f64 * 0.41).cos());
+        let a = b.transpose() * b + SMatrix::<f64, 5, 5>::identity() * 0.1;
+        let x = SVector::<f64, 5>::from_fn(|i, _| i as f64 - 1.7);
+        let direct = x.dot(&(a * x));
+        let ours = Ldlt::new(&a).unwrap().quadratic_form(&x);
+        assert!((ours - direct).abs() <= 1e-13 * direct, "{ours} {direct}");
     }
 
     #[test]

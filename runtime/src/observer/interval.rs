@@ -983,9 +983,9 @@ where
         } = OnSet::new(jac, &at.free.chol, set);
         let settled = w - minv_jt * delassus?.solve(&speed);
         // the projection cannot raise the kinetic energy; where rounding
-        // in a nearly singular `J_S M⁻¹J_Sᵀ` made it, keep `w`
-        let mass = self.model.mass(at.p);
-        let energy = |v: &SVector<T, N>| v.dot(&(mass * v));
+        // in a nearly singular `J_S M⁻¹J_Sᵀ` made it, keep `w` (the
+        // energies from the factor of `M` the point already has)
+        let energy = |v: &SVector<T, N>| at.free.chol.quadratic_form(v);
         let slack = T::one() + T::default_epsilon() * nalgebra::convert(64.0);
         (energy(&settled) <= energy(w) * slack).then_some(settled)
     }
