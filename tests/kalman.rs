@@ -1065,18 +1065,18 @@ fn example_1_figures_beside_the_reduced_order_observer() {
 /// what the noise leaves unknown after fast impacts on the curved floor
 /// (a position known to 3e-5 m before the impact is a normal known to
 /// about 6e-5 rad, and a velocity after it uncertain by up to 1e-3 m/s
-/// there). (38)'s maximum off the bracketing samples is at most 0.1 on 45
-/// of the 48 (0.125, 0.143 and 0.196 on the other three). On seed 1234,
-/// start 9, three samples 2.4 to 3.8 σ low moved the smoothed position
-/// about seven of its deviations below the truth, and a bounce approached
-/// at 0.14 m/s was located 1.3 ms early, so a sample that no bracket
-/// excludes carries the whole jump. On seed 1234, start 5, and seed 777,
-/// start 11, the mass micro-bounces (3.6 to 5.0 ms apart, approached at
-/// 0.12 to 0.25 m/s, peaks of 1.6e-4 to 2.5e-4 m) while it slides fast
-/// along the curved floor, whose curvature bends the normal velocity at
-/// 60 to 100 m/s²: an impact located a millisecond off (one missed for
-/// an interval on 1234/5) leaves 0.07 to 0.2 m/s on the samples between
-/// bounces (README "Under noise").
+/// there). (38)'s maximum off the bracketing samples is at most 0.1 on 47
+/// of the 48 (0.196 on seed 1234, start 5). There the mass micro-bounces
+/// (3.6 to 5.0 ms apart, approached at 0.12 to 0.25 m/s, peaks of 1.6e-4
+/// to 2.5e-4 m) while it slides fast along the curved floor, whose
+/// curvature bends the normal velocity at 60 to 100 m/s²: an impact
+/// located a millisecond off (one missed for an interval) leaves 0.07 to
+/// 0.2 m/s on the samples between bounces. While the smoothed position
+/// was held within `n_σ σ` of each sample, seed 1234, start 9, reached
+/// 0.125 (three samples 2.4 to 3.8 σ low pulled it seven of its
+/// deviations under the truth, and a bounce was located 1.3 ms early)
+/// and seed 777, start 11, 0.143; held within four deviations of `q̄ − q`
+/// they are at 0.089 and 0.084 (README "Under noise").
 #[test]
 fn example_1_random_starts_beside_the_reduced_order_observer() {
     let model = Parabola::<f64>::new();
