@@ -754,7 +754,7 @@ fn below_the_latest_jump<const N: usize>(
 /// a median of 1.1 to 1.3 × `√2 l_d σ` at `σ ≤ 1e-5`: the floor, held at
 /// acceleration level, kept each separating injection's normal speed for
 /// as long as the rule held it, and pushed on it. The window's median was
-/// 1.52 × at `σ = 1e-6` (now 0.89 ×); this comment then put the excess
+/// 1.52 × at `σ = 1e-6` (now 0.90 ×); this comment then put the excess
 /// down to the noisy tangent of the contact, and asserted the flight's
 /// floor over the whole window.
 #[test]
