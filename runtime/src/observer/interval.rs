@@ -597,6 +597,11 @@ where
     /// the first update). A closed constraint approaching slower than that
     /// cannot be told from a resting one.
     pub uncertainty: T,
+    /// The contact rule's band `b_i` of each constraint, in units of `q`:
+    /// [`ObserverParams::contact_band`] for every constraint (set by
+    /// [`begin`](Self::begin)); the filter sets each from the uncertainty
+    /// of that constraint's own gap.
+    pub bands: SVector<T, K>,
     /// The velocity noise `ν` of the contact rule: for the observers
     /// `n_σ √2 σ (1 − e^{−l_d τ})/τ`, the injection passing the noise of
     /// two samples with the gain of one interval (set by
@@ -685,6 +690,7 @@ where
             q1: *q,
             restitution,
             uncertainty: memory.report.uncertainty(),
+            bands: SVector::repeat(memory.params.contact_band()),
             noise_speed: memory.params.noise_sigmas
                 * memory.params.noise
                 * nalgebra::convert::<f64, T>(core::f64::consts::SQRT_2)
@@ -1170,7 +1176,6 @@ where
             bounced,
         } = path;
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
-        let band = self.params.contact_band();
         let mut c = Classes::default();
         let noise_speed = self.noise_speed;
         let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
@@ -1179,12 +1184,12 @@ where
         let kept = touched.union(held);
         for i in 0..K {
             let row = jac.row(i);
-            if !kept.contains(i) && clearly_open(h[i], row.norm_squared(), band) {
+            if !kept.contains(i) && clearly_open(h[i], row.norm_squared(), self.bands[i]) {
                 c.free.insert(i);
                 continue;
             }
             let g = row.norm();
-            if h[i] <= g * band || kept.contains(i) {
+            if h[i] <= g * self.bands[i] || kept.contains(i) {
                 closed.insert(i);
             } else {
                 c.free.insert(i);
@@ -1215,7 +1220,7 @@ where
             }
             let floor = roundoff * g;
             let rest = self.params.rest_factor * self.tau * normal_accel
-                + (four * normal_accel * g * band).sqrt()
+                + (four * normal_accel * g * self.bands[i]).sqrt()
                 + g * noise_speed
                 + floor;
             // separating: see `release_departures`
@@ -1278,9 +1283,9 @@ where
         (speed, alpha): (&SVector<T, K>, &SVector<T, K>),
         (closed, touched): (IndexSet<K>, IndexSet<K>),
     ) -> Result<IndexSet<K>, T> {
-        let band = self.params.contact_band();
-        let turns =
-            |i: usize, alpha: T| turns_within_band(h[i], speed[i], alpha, jac.row(i).norm() * band);
+        let turns = |i: usize, alpha: T| {
+            turns_within_band(h[i], speed[i], alpha, jac.row(i).norm() * self.bands[i])
+        };
         let mut grazed = IndexSet::EMPTY;
         for i in closed.difference(touched) {
             if turns(i, alpha[i]) {
@@ -1316,10 +1321,9 @@ where
         resolved: IndexSet<K>,
         path: Path<K>,
     ) -> Result<Classes<K>, T> {
-        let band = self.params.contact_band();
         if path.touched.is_empty()
             && path.held.is_empty()
-            && (0..K).all(|i| clearly_open(h[i], jac.row(i).norm_squared(), band))
+            && (0..K).all(|i| clearly_open(h[i], jac.row(i).norm_squared(), self.bands[i]))
         {
             return Ok(Classes {
                 free: IndexSet::full(K),
@@ -1488,12 +1492,12 @@ where
     /// The first constraint to close along the segment (see the module
     /// docs: an open gap that ends closed, an open gap that dips below zero
     /// and reopens, a separating contact that comes back; the contact band of
-    /// constraint `i` at the segment's start is `|J_i| b`, from `(J, b)`).
+    /// constraint `i` at the segment's start is `|J_i| b_i`, from `(J, b)`).
     fn first_crossing(
         &self,
         seg: &Segment<T, N>,
         c: &Classes<K>,
-        (jac, band): (&SMatrix<T, K, N>, T),
+        (jac, bands): (&SMatrix<T, K, N>, &SVector<T, K>),
         start: (&SVector<T, K>, &SVector<T, K>),
         end: (&SVector<T, K>, &SVector<T, K>),
     ) -> Result<Option<Crossing<T, K>>, T> {
@@ -1537,7 +1541,7 @@ where
                 // turning point (normal speed zero) it is a persistent
                 // contact
                 let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
-                if fm > jac.row(i).norm() * band {
+                if fm > jac.row(i).norm() * bands[i] {
                     record(self.root(seg, i, [(m / seg.h, fm), (one, h1[i])], None)?, i);
                 } else {
                     record(m, i);
@@ -1570,7 +1574,6 @@ where
         // through `Result` costs a store-forwarding stall on reading it)
         let (h, jac) = self.model.contact(&self.q1);
         check_contact(&h, &jac)?;
-        let band = self.params.contact_band();
         let scale = T::default_epsilon() * nalgebra::convert(64.0);
         // the cheap tests first: a constraint the estimate does not
         // approach (`J_i v ≥ 0`), or a gap clearly open, needs no norm
@@ -1579,12 +1582,12 @@ where
             let jv = row.dot(&v.transpose());
             // (`jv ≥ 0` or NaN: not approaching)
             if jv.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Less)
-                || clearly_open(h[i], row.norm_squared(), band)
+                || clearly_open(h[i], row.norm_squared(), self.bands[i])
             {
                 return false;
             }
             let g = row.norm();
-            h[i] <= g * band && jv < -(scale * v.norm()) * g
+            h[i] <= g * self.bands[i] && jv < -(scale * v.norm()) * g
         });
         if !approaching {
             return Ok(*v);

@@ -198,9 +198,8 @@ where
                 };
                 let rate0 = jac * w;
                 let rate1 = jac1 * arc.w;
-                let band = self.params.contact_band();
                 if let Some(Crossing { at, set }) =
-                    self.first_crossing(&seg, &c, (&jac, band), (&h, &rate0), (&h1, &rate1))?
+                    self.first_crossing(&seg, &c, (&jac, &self.bands), (&h, &rate0), (&h1, &rate1))?
                 {
                     let part = self.advance(&point, at, c.sliding, &stage, report)?;
                     tracer.flight(&Flight {
