@@ -801,7 +801,8 @@ where
         };
         interval.uncertainty = rule.noise_sigmas * sigma_v;
         // each constraint's band from the deviation of its own gap,
-        // `√(J_i P_qq J_iᵀ) / |J_i|`, at most `σ`
+        // `√(J_i P_qq J_iᵀ) / |J_i|`, at least the rounding of `q` and at
+        // most `σ`
         let (_, jac) = interval.contact(&self.q)?;
         let rounding = position_rounding(&self.q);
         for i in 0..K {
