@@ -431,3 +431,10 @@ mod infeasible_state {
         check(FullOrder::<f64, 1, 0>::new(params, gains, 0.0, Vector1::new(0.0), v0).unwrap());
     }
 }
+
+/// Seeded Gaussian samples for the unit tests: the integration tests'
+/// generator (`tests/common/gauss.rs`), included by path so that both
+/// suites draw from one source.
+#[path = "../../tests/common/gauss.rs"]
+mod gauss;
+pub(crate) use gauss::Gauss;

@@ -1492,12 +1492,13 @@ where
     /// The first constraint to close along the segment (see the module
     /// docs: an open gap that ends closed, an open gap that dips below zero
     /// and reopens, a separating contact that comes back; the contact band of
-    /// constraint `i` at the segment's start is `|J_i| b_i`, from `(J, b)`).
+    /// constraint `i` at the segment's start is `|J_i| b_i`, from `J` and
+    /// [`bands`](Self::bands)).
     fn first_crossing(
         &self,
         seg: &Segment<T, N>,
         c: &Classes<K>,
-        (jac, bands): (&SMatrix<T, K, N>, &SVector<T, K>),
+        jac: &SMatrix<T, K, N>,
         start: (&SVector<T, K>, &SVector<T, K>),
         end: (&SVector<T, K>, &SVector<T, K>),
     ) -> Result<Option<Crossing<T, K>>, T> {
@@ -1541,7 +1542,7 @@ where
                 // turning point (normal speed zero) it is a persistent
                 // contact
                 let (m, fm) = self.extremum(seg, i, zero, seg.h)?;
-                if fm > jac.row(i).norm() * bands[i] {
+                if fm > jac.row(i).norm() * self.bands[i] {
                     record(self.root(seg, i, [(m / seg.h, fm), (one, h1[i])], None)?, i);
                 } else {
                     record(m, i);

@@ -199,7 +199,7 @@ where
                 let rate0 = jac * w;
                 let rate1 = jac1 * arc.w;
                 if let Some(Crossing { at, set }) =
-                    self.first_crossing(&seg, &c, (&jac, &self.bands), (&h, &rate0), (&h1, &rate1))?
+                    self.first_crossing(&seg, &c, &jac, (&h, &rate0), (&h1, &rate1))?
                 {
                     let part = self.advance(&point, at, c.sliding, &stage, report)?;
                     tracer.flight(&Flight {

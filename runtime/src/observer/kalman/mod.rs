@@ -802,22 +802,25 @@ where
         interval.uncertainty = rule.noise_sigmas * sigma_v;
         // each constraint's band from the deviation of its own gap,
         // `√(J_i P_qq J_iᵀ) / |J_i|`, at least the rounding of `q` and at
-        // most `σ`
-        let (_, jac) = interval.contact(&self.q)?;
-        let rounding = position_rounding(&self.q);
-        for i in 0..K {
-            let row = jac.row(i);
-            let g2 = row.norm_squared();
-            let deviation = if g2 > T::zero() {
-                ((row * self.p.qq).dot(&row) / g2)
-                    .max(T::zero())
-                    .sqrt()
-                    .max(rounding)
-            } else {
-                sigma_q
-            };
-            interval.bands[i] = self.params.observer.contact_distance
-                + self.params.band_sigmas * deviation.min(self.params.observer.noise);
+        // most `σ` (where the model fails at the estimate the whole
+        // estimate's band stays, and the prediction's own failure restarts
+        // the filter, as it did before the bands were per constraint)
+        if let Ok((_, jac)) = interval.contact(&self.q) {
+            let rounding = position_rounding(&self.q);
+            for i in 0..K {
+                let row = jac.row(i);
+                let g2 = row.norm_squared();
+                let deviation = if g2 > T::zero() {
+                    ((row * self.p.qq).dot(&row) / g2)
+                        .max(T::zero())
+                        .sqrt()
+                        .max(rounding)
+                } else {
+                    sigma_q
+                };
+                interval.bands[i] = self.params.observer.contact_distance
+                    + self.params.band_sigmas * deviation.min(self.params.observer.noise);
+            }
         }
         // no injection: the filter's correction is its Kalman gain
         report.gain = T::zero();
