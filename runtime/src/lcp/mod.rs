@@ -69,6 +69,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 mod enumerate;
 mod error;
 mod index_set;
+mod on_set;
 mod pivot;
 mod residual;
 mod search;
@@ -76,6 +77,7 @@ mod trial;
 
 pub use error::LcpError;
 pub use index_set::{IndexSet, Iter as IndexSetIter};
+pub(crate) use on_set::OnSet;
 pub use residual::lcp_residual;
 
 use residual::natural_residual;

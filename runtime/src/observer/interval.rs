@@ -7,8 +7,8 @@
 
 use nalgebra::{RealField, SMatrix, SVector};
 
-use crate::lcp::{IndexSet, Lcp};
-use crate::linalg::{Ldlt, OnSet};
+use crate::lcp::{IndexSet, Lcp, OnSet};
+use crate::linalg::Ldlt;
 use crate::model::Model;
 
 use super::{ObserverError, ObserverParams, UpdateReport, check_update};

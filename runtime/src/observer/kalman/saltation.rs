@@ -7,8 +7,8 @@
 
 use nalgebra::{RealField, SMatrix, SVector};
 
-use crate::lcp::IndexSet;
-use crate::linalg::{Ldlt, OnSet};
+use crate::lcp::{IndexSet, OnSet};
+use crate::linalg::Ldlt;
 use crate::model::Sensitivities;
 
 use super::super::ObserverError;
