@@ -250,7 +250,8 @@ where
     /// the plastic closures by which the filter enters a slide; with the
     /// timing term there as well, the median velocity error over
     /// `[2, 10]` s of the model file's start (σ = 1e-4, defaults) was
-    /// 2.7e-5 m/s instead of 2.1e-5 (README, "Under noise").
+    /// 2.7e-5 m/s instead of 2.1e-5 when this rule was made (a scratch
+    /// run; the current figure is in README, "Under noise").
     fn impact_noise(
         &self,
         s: &Saltation<T, N, K>,
