@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CasADi's side of the README's scaling table ("Real robots"): for each
+"""CasADi's side of the README's scaling table ("Recursions, not energies"): for each
 chain of N joints written by gen.py beside this script (N = 2..12), the
 quantities moreau generates for the model of scaling.sh (one constraint,
 ``position_z(lN, 0.02, -0.01, 0.1) + 0.5``), built in CasADi SX from the

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The scaling figures of the README ("Real robots"): for each chain of N
+# The scaling figures of the README ("Recursions, not energies"): for each chain of N
 # joints written by gen.py beside this script (N = 2..12), a scratch crate
 # in $SCRATCH (default /tmp/moreau-scaling) holding that one model (file
 # form, one constraint on the last link), expanded and built in release
