@@ -223,24 +223,30 @@ where
     (v + minv_jt * lambda, lambda)
 }
 
-/// Flow for `t1` from `x0` through the impact on `guard` (Newton's law on
-/// `set`), then on to `t_end` in all.
+/// Flow from `x0` through the impact on `guard` (Newton's law on `set`),
+/// then on to `t_end` in all; with `delay ≠ 0` the impact comes `delay`
+/// after the gap's root, the free motion continuing into the constraint
+/// until then (a late impact, as the plant's).
 fn flow_impact_flow<M, const N: usize, const K: usize>(
     model: &M,
     u: &M::Input,
     x0: &DVector<f64>,
     guard: usize,
-    set: IndexSet<K>,
-    e: &SVector<f64, K>,
-    t_end: f64,
+    (set, e): (IndexSet<K>, &SVector<f64, K>),
+    (delay, t_end): (f64, f64),
 ) -> DVector<f64>
 where
     M: Model<N, K, Scalar = f64>,
 {
     let (x, t) = flow_to_guard::<M, N, K>(model, u, x0, guard);
+    let x = if delay == 0.0 {
+        x
+    } else {
+        flow::<M, N, K>(model, u, &x, delay)
+    };
     let (q, v) = unstack::<N>(&x);
     let (v_plus, _) = newton_reset::<M, N, K>(model, &q, &v, set, e);
-    flow::<M, N, K>(model, u, &stack(&q, &v_plus), t_end - t)
+    flow::<M, N, K>(model, u, &stack(&q, &v_plus), t_end - t - delay)
 }
 
 /// Jacobian of `f` at `x` by central differences.
@@ -341,7 +347,7 @@ where
     .unwrap();
     let x_plus = stack(&q_hit, &v_plus);
     let total = jacobian_fd(
-        |x| flow_impact_flow::<M, N, K>(model, u, x, guard, set, &e, 2.0 * delta),
+        |x| flow_impact_flow::<M, N, K>(model, u, x, guard, (set, &e), (0.0, 2.0 * delta)),
         &x0,
     );
     let before = jacobian_fd(|x| flow::<M, N, K>(model, u, x, t_hit), &x0);
@@ -657,19 +663,16 @@ fn the_plants_impacts_are_exact_impacts_delayed() {
         let before = plant.samples[(t_hit / tau).round() as usize - 3];
         let after = plant.samples[((t_hit + 2e-4) / tau).round() as usize];
         let x0 = stack(&before.q, &before.v);
+        let floor = IndexSet::from_indices(&[0]).unwrap();
         let exact = |delay: f64| -> (SVector<f64, 2>, SVector<f64, 2>) {
-            let (x, t) = flow_to_guard::<Parabola<f64>, 2, 2>(&model, &u, &x0, 0);
-            let x = flow::<Parabola<f64>, 2, 2>(&model, &u, &x, delay);
-            let (q, v) = unstack::<2>(&x);
-            let mut set = IndexSet::EMPTY;
-            set.insert(0);
-            let (v_plus, _) = newton_reset::<Parabola<f64>, 2, 2>(&model, &q, &v, set, &e);
-            let rest = after.t - before.t - t - delay;
-            unstack::<2>(&flow::<Parabola<f64>, 2, 2>(
+            let t_end = after.t - before.t;
+            unstack::<2>(&flow_impact_flow::<Parabola<f64>, 2, 2>(
                 &model,
                 &u,
-                &stack(&q, &v_plus),
-                rest,
+                &x0,
+                0,
+                (floor, &e),
+                (delay, t_end),
             ))
         };
         let (q, v) = exact(0.0);
@@ -716,14 +719,17 @@ fn a_mean_impact_delay_moves_the_prediction_as_a_delayed_impact_does() {
     let t_end = 0.2;
     let e = model.restitution();
     // the truth, the impact delayed by `delay` past the gap's root
+    let floor = IndexSet::from_indices(&[0]).unwrap();
     let truth = |delay: f64| -> SVector<f64, 2> {
-        let (x, t) = flow_to_guard::<Parabola<f64>, 2, 2>(&model, &u, &stack(&q0, &v0), 0);
-        let x = flow::<Parabola<f64>, 2, 2>(&model, &u, &x, delay);
-        let (q, v) = unstack::<2>(&x);
-        let mut set = IndexSet::EMPTY;
-        set.insert(0);
-        let (v_plus, _) = newton_reset::<Parabola<f64>, 2, 2>(&model, &q, &v, set, &e);
-        let x = flow::<Parabola<f64>, 2, 2>(&model, &u, &stack(&q, &v_plus), t_end - t - delay);
+        let x0 = stack(&q0, &v0);
+        let x = flow_impact_flow::<Parabola<f64>, 2, 2>(
+            &model,
+            &u,
+            &x0,
+            0,
+            (floor, &e),
+            (delay, t_end),
+        );
         unstack::<2>(&x).0
     };
     let predicted = |delay: f64| -> SVector<f64, 2> {

@@ -218,6 +218,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
     fn integrate<M>(
         &self,
         interval: &Interval<'_, M, T, N, K>,
+        beta: T,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, SVector<T, N>), Restart>
     where
@@ -259,7 +260,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
                     v
                 };
                 // CLOSE: v̂_e ∈ V(q̄_{k+1}) (V(q_{k+1}) without noise)
-                let end = smoothed(&self.params, interval.tau, &interval.q1, &p_end);
+                let end = smoothed(&self.params, beta, &interval.q1, &p_end);
                 let v = if end == interval.q1 {
                     interval.close_at_end(&v, report)?
                 } else {
@@ -301,7 +302,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
 }
 
 /// The weight `β` of the measurement in the smoothed position (see
-/// [`smoothed`]): `1` without noise, else `min(1, (4 l_d τ)^{2/3})`.
+/// [`smoothed`]): `1` without noise or for the Section VII scheme (which
+/// steps from the sample), else `min(1, (4 l_d τ)^{2/3})`.
 ///
 /// Where it comes from: `q̄_{k+1} = p + β (q_{k+1} − p)`, `p` the predicted
 /// end of the interval, passes the measurement noise with the standard
@@ -310,7 +312,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
 /// sum is smallest at `β^{3/2} = 4 l_d τ` (about `0.12` for `l_d τ = 0.01`,
 /// a third of the noise), whatever `σ`.
 pub(crate) fn smoothing<T: RealField + Copy>(params: &ObserverParams<T>, tau: T) -> T {
-    if params.noise == T::zero() {
+    if params.noise == T::zero() || params.scheme != Discretization::ImpactAware {
         return T::one();
     }
     let four: T = nalgebra::convert(4.0);
@@ -324,8 +326,8 @@ pub(crate) fn smoothing<T: RealField + Copy>(params: &ObserverParams<T>, tau: T)
 const SMOOTHING_GATE: f64 = 4.0;
 
 /// The smoothed position `q̄_{k+1}` from the measured `q_{k+1}` and the
-/// predicted end `p` of the interval: `p + β (q_{k+1} − p)` ([`smoothing`]),
-/// the measurement itself when `σ = 0`.
+/// predicted end `p` of the interval: `p + β (q_{k+1} − p)` (`β` from
+/// [`smoothing`]), the measurement itself when `β = 1` (`σ = 0`).
 ///
 /// It is held within four deviations ([`SMOOTHING_GATE`]) of the
 /// measurement in each coordinate, the deviation being that of
@@ -345,11 +347,10 @@ const SMOOTHING_GATE: f64 = 4.0;
 /// and the bounce located 0.8 ms early, inside its bracketing samples).
 pub(crate) fn smoothed<T: RealField + Copy, const N: usize>(
     params: &ObserverParams<T>,
-    tau: T,
+    beta: T,
     q1: &SVector<T, N>,
     p: &SVector<T, N>,
 ) -> SVector<T, N> {
-    let beta = smoothing(params, tau);
     if beta >= T::one() {
         return *q1;
     }
@@ -361,14 +362,18 @@ pub(crate) fn smoothed<T: RealField + Copy, const N: usize>(
 }
 
 /// The settings the interval sees under noise: `σ` replaced by the noise
-/// of the smoothed position, `σ √(β/(2 − β))` ([`smoothing`]); unchanged
+/// of the smoothed position, `σ √(β/(2 − β))` (`β` from [`smoothing`]
+/// for this `τ`); unchanged
 /// without noise or for a `τ` that is not positive (refused later).
-fn smoothed_noise<T: RealField + Copy>(params: &ObserverParams<T>, tau: T) -> ObserverParams<T> {
+fn smoothed_noise<T: RealField + Copy>(
+    params: &ObserverParams<T>,
+    tau: T,
+    beta: T,
+) -> ObserverParams<T> {
     let positive = tau > T::zero();
     if params.noise == T::zero() || !positive || params.scheme != Discretization::ImpactAware {
         return *params;
     }
-    let beta = smoothing(params, tau);
     let two: T = nalgebra::convert(2.0);
     params.with_noise(params.noise * (beta / (two - beta)).sqrt())
 }
@@ -455,7 +460,10 @@ where
         q: &SVector<T, N>,
         u: &M::Input,
     ) -> Result<Estimate<T, N>, ObserverError<T>> {
-        let smoothed_params = smoothed_noise(&self.params, t - self.t);
+        // `β` once per update: the interval's noise and the smoothing of
+        // its end share it
+        let beta = smoothing(&self.params, t - self.t);
+        let smoothed_params = smoothed_noise(&self.params, t - self.t, beta);
         let memory = Memory {
             params: &smoothed_params,
             lcp: &self.lcp,
@@ -472,7 +480,7 @@ where
             .screen(&self.params, (t, interval.tau), &self.q, q)?;
         let mut report = fresh;
         let integrated = match plan {
-            Plan::Integrate => self.integrate(&interval, &mut report),
+            Plan::Integrate => self.integrate(&interval, beta, &mut report),
             Plan::Restart(why) => Err(why),
         };
         let (v, smooth) = match integrated {
@@ -553,7 +561,7 @@ mod tests {
         let (warm_up, count) = (1_000, 400_000);
         for k in 0..warm_up + count {
             let q = Vector1::new(sigma * gauss.normal());
-            let next = smoothed(&params, tau, &q, &q_bar);
+            let next = smoothed(&params, beta, &q, &q_bar);
             let free = q_bar + (q - q_bar) * beta;
             if k >= warm_up {
                 sum_sq += (next - q)[0].powi(2);
