@@ -55,7 +55,9 @@
 //!      Jacobian of the constrained flow
 //!      ([`constrained_flow_jacobian`]), `P ← Φ P Φᵀ + Q(h)`, then `P`
 //!      projected onto the tangent space of the contact manifold at the
-//!      end of the piece, `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
+//!      end of the piece (less the constraints the motion lifts off there:
+//!      no force and a separating acceleration and speed at the end, module
+//!      `propagate`), `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
 //!      `J_S δq = 0` and `∂(J_S v)/∂q δq + J_S δv = 0`
 //!      ([`Sensitivities::jacobian_dq`]), in the metric of `M` (that of a
 //!      plastic impact): `P ← B P Bᵀ`, a congruence, so positive

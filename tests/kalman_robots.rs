@@ -1,0 +1,290 @@
+//! The saltation Kalman filter on robots given as URDF, under noise: a UR5
+//! with damped joints whose tool strikes a table, rests on it and swings
+//! off it again (`examples/ur5_table.yaml`), a Franka Panda with a table
+//! and walls (`tests/robots/panda.yaml`) and Unitree Go1's twelve leg
+//! joints with the ground and walls under two feet
+//! (`tests/robots/go1.yaml`). Each runs from random starts on the plant
+//! (Moreau–Jean at `τ = 1e-5`), its joint positions sampled at 1 kHz with
+//! Gaussian noise `σ = 1e-4` rad, `v̂(0) = 0`; the filter with its
+//! defaults beside the reduced-order observer (38) (`l_d = 20`), both told
+//! `σ`, scored over `[1, 3]` s against the plant's velocities.
+//!
+//! Nothing in the filter is written for these robots: the dynamics, the
+//! constraint Jacobians and the derivatives its saltation matrices and
+//! contact projections need come from the URDF through `model!`.
+
+mod common;
+
+use common::runs::{Gauss, Reference, Scored, brackets, measure, reference, score};
+use moreau::{
+    Estimate, KalmanParams, Model, Observer, ObserverError, ObserverParams, ReducedOrder,
+    SaltationKalman, Sensitivities,
+};
+use nalgebra::SVector;
+
+moreau::model!(file = "examples/ur5_table.yaml");
+moreau::model!(file = "tests/robots/panda.yaml");
+moreau::model!(file = "tests/robots/go1.yaml");
+
+const SIGMA: f64 = 1e-4;
+const WINDOW: (f64, f64) = (1.0, 3.0);
+/// The velocity bound told to both estimators: above every joint speed
+/// the runs reach (asserted; the undamped Panda whips its wrist to 67
+/// rad/s).
+const VELOCITY_BOUND: f64 = 150.0;
+
+/// One run of both estimators on one start.
+struct Run {
+    filter: Scored,
+    observer: Scored,
+    /// Restarts and refused samples, filter and (38).
+    restarts: (usize, usize),
+    refused: (usize, usize),
+    /// The median over the window (without the samples that bracket a
+    /// plant impact) of the filter's velocity NEES `eᵀ P_vv⁻¹ e`.
+    nees_median: f64,
+}
+
+/// Random starts of `model`: the first `first` if given, then joint
+/// angles uniform in `[−1.5, 1.5]` rad and speeds in `[−1, 1]` rad/s
+/// (seed 27182, none picked), every gap at least 2 cm open.
+fn starts<M, const N: usize, const K: usize>(
+    model: &M,
+    first: Option<(SVector<f64, N>, SVector<f64, N>)>,
+    count: usize,
+) -> Vec<(SVector<f64, N>, SVector<f64, N>)>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    let mut g = Gauss::new(27182);
+    let mut starts: Vec<_> = first.into_iter().collect();
+    while starts.len() < count {
+        let q = SVector::<f64, N>::from_fn(|_, _| 1.5 * (2.0 * g.uniform() - 1.0));
+        let v = SVector::<f64, N>::from_fn(|_, _| 2.0 * g.uniform() - 1.0);
+        if model.gaps(&q).iter().all(|&h| h >= 0.02) {
+            starts.push((q, v));
+        }
+    }
+    starts
+}
+
+/// Every update of `estimator` over the run; counts its restarts and the
+/// samples it refused as outliers (the estimate held there); `each` sees
+/// the estimator after every accepted update.
+fn observe<M, O, const N: usize, const K: usize>(
+    estimator: &mut O,
+    model: &M,
+    (data, measured): (&Reference<N>, &[SVector<f64, N>]),
+    mut each: impl FnMut(usize, &O),
+) -> (Vec<Estimate<f64, N>>, usize, usize)
+where
+    M: Model<N, K, Scalar = f64, Input: Default>,
+    O: Observer<M, N, K>,
+{
+    let u = M::Input::default();
+    let mut estimates = vec![estimator.estimate()];
+    let (mut restarts, mut refused) = (0, 0);
+    for (j, (s, q)) in data.samples.iter().zip(measured).enumerate().skip(1) {
+        match estimator.update(model, s.t, q, &u) {
+            Ok(e) => {
+                restarts += usize::from(estimator.report().restart.is_some());
+                estimates.push(e);
+                each(j, estimator);
+            }
+            Err(ObserverError::Outlier { .. }) => {
+                refused += 1;
+                estimates.push(estimator.estimate());
+            }
+            Err(e) => panic!("{}, t = {}: {e:?}", M::INFO.name, s.t),
+        }
+    }
+    (estimates, restarts, refused)
+}
+
+/// Both estimators on the plant's run from `start`, measured with the
+/// noise seed `seed`.
+fn run<M, const N: usize, const K: usize>(
+    model: &M,
+    start: (SVector<f64, N>, SVector<f64, N>),
+    seed: u64,
+) -> Run
+where
+    M: Sensitivities<N, K, Scalar = f64, Input: Default>,
+{
+    let data = reference(model, start, 1e-5, 100, WINDOW.1, &M::Input::default());
+    let fastest = data.samples.iter().map(|s| s.v.amax()).fold(0.0, f64::max);
+    assert!(
+        fastest < VELOCITY_BOUND,
+        "{}: {fastest} rad/s",
+        M::INFO.name
+    );
+    let measured = measure(&data, SIGMA, seed);
+    let bracket = brackets(&data);
+    let mut filter = SaltationKalman::<f64, N, K>::new(
+        KalmanParams::new(VELOCITY_BOUND, SIGMA),
+        0.0,
+        measured[0],
+        SVector::zeros(),
+    )
+    .unwrap();
+    let mut nees = Vec::new();
+    let (estimates, f_restarts, f_refused) =
+        observe(&mut filter, model, (&data, &measured), |j, f| {
+            let s = &data.samples[j];
+            if s.t >= WINDOW.0 && !bracket[j] {
+                let e = s.v - f.estimate().v;
+                let chol = f
+                    .covariance()
+                    .vv
+                    .cholesky()
+                    .expect("P_vv positive definite");
+                nees.push(e.dot(&chol.solve(&e)));
+            }
+        });
+    let filter_scored = score(&data, &estimates, WINDOW);
+    let mut observer = ReducedOrder::<f64, N, K>::new(
+        ObserverParams::new(20.0, VELOCITY_BOUND).with_noise(SIGMA),
+        0.0,
+        measured[0],
+        SVector::zeros(),
+    )
+    .unwrap();
+    let (estimates, o_restarts, o_refused) =
+        observe(&mut observer, model, (&data, &measured), |_, _| {});
+    nees.sort_by(f64::total_cmp);
+    Run {
+        filter: filter_scored,
+        observer: score(&data, &estimates, WINDOW),
+        restarts: (f_restarts, o_restarts),
+        refused: (f_refused, o_refused),
+        nees_median: nees[nees.len() / 2],
+    }
+}
+
+fn print(name: &str, n: usize, r: &Run) {
+    eprintln!(
+        "{name}, start {n}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}, velocity NEES median {:.2}, restarts {} refused {}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.2e}, restarts {} refused {}",
+        r.filter.all.median,
+        r.filter.all.p90,
+        r.filter.clean.max,
+        r.nees_median,
+        r.restarts.0,
+        r.refused.0,
+        r.observer.all.median,
+        r.observer.all.p90,
+        r.observer.clean.max,
+        r.restarts.1,
+        r.refused.1,
+    );
+}
+
+/// The χ² median with `n` degrees of freedom (Wilson–Hilferty).
+fn chi_square_median(n: usize) -> f64 {
+    let c = 2.0 / (9.0 * n as f64);
+    n as f64 * (1.0 - c).powi(3)
+}
+
+/// A UR5 whose tool strikes a table, bounces, rests and slides on it, and
+/// swings off it again as the arm moves (the model file's start and five
+/// random ones; 7 to 12 plant impacts each).
+///
+/// The tool's contact force runs out inside a sampling interval when the
+/// arm lifts it off; the filter's prediction lifts off with it (the
+/// interval holds a contact at acceleration level), but the filter then
+/// projected the end of the piece onto the contact manifold, which took
+/// the separating speed back out and, the covariance projected with it,
+/// left the joint velocities 2.2e-4 rad/s off while the filter claimed
+/// 3.1e-5, for hundreds of milliseconds. Medians were 1.7e-5 to 6.5e-5
+/// and the velocity NEES median up to 19 (6 joints) on these six runs;
+/// now the end is projected only onto the contacts it still lies on
+/// (module docs of `runtime/src/observer/kalman/propagate.rs`, `lifted`).
+///
+/// Asserted on every run: no restart and at most one sample refused (the
+/// gate's false alarms: 3.2e-5 per sample, 0.06 per run); the issue's
+/// Example 1 targets, median at most 3e-5 rad/s and at most 1e-2 off the
+/// samples that bracket a plant impact; the median at least twenty times
+/// below (38)'s (the factor by which the hand-written Python
+/// saltation filter beat (38)); and the covariance not overconfident on
+/// the typical sample: the velocity NEES median at most the χ² median
+/// with 6 degrees of freedom (5.35).
+#[test]
+fn the_filter_follows_a_ur5_onto_and_off_a_table() {
+    let model = Ur5Table::<f64>::new();
+    let starts = starts::<_, 6, 1>(&model, Some(Ur5Table::<f64>::initial_state()), 6);
+    for (n, &start) in starts.iter().enumerate() {
+        let r = run::<_, 6, 1>(&model, start, 7 + n as u64);
+        print("UR5 on a table", n, &r);
+        let at = format!("start {n}");
+        assert_eq!(r.restarts, (0, 0), "{at}");
+        assert!(
+            r.refused.0 <= 1 && r.refused.1 <= 1,
+            "{at}: {:?}",
+            r.refused
+        );
+        assert!(
+            r.filter.all.median <= 3e-5,
+            "{at}: {:e}",
+            r.filter.all.median
+        );
+        assert!(r.filter.clean.max <= 1e-2, "{at}: {:e}", r.filter.clean.max);
+        assert!(
+            20.0 * r.filter.all.median <= r.observer.all.median,
+            "{at}: {:e} against (38)'s {:e}",
+            r.filter.all.median,
+            r.observer.all.median
+        );
+        assert!(
+            r.nees_median <= chi_square_median(6),
+            "{at}: NEES median {}",
+            r.nees_median
+        );
+    }
+}
+
+/// A Franka Panda (seven joints, no damping: its wrist whips up to 67
+/// rad/s) and Go1's legs (twelve joints, six constraints), four and three
+/// random starts.
+///
+/// Asserted on every run: no restart and at most one sample refused by
+/// either estimator; the filter's median at least five times below (38)'s
+/// (measured: 8 to 45 times), and off the bracketing samples within the
+/// issue's 0.1 (measured: at most 2.2e-2, on Go1's feet among the walls;
+/// (38), printed, up to 9.6e-2 there).
+///
+/// Printed, not asserted: the filter's velocity NEES. With the default
+/// process noise it is above the χ² median on these fast runs (6.7 to 40
+/// for the Panda's 7 joints, 9.5 to 81 for Go1's 12): the defaults
+/// describe a model as right as a fine simulation is.
+/// `tune_process_noise`, run on one record of the Panda (the first start,
+/// another noise seed), raised the acceleration noise 2.7 times, the
+/// impact noise 11 times and the mean delay to 2.3 µs, and brought the
+/// NEES mean on the four starts to 4.9 to 6.6 (a scratch run, README
+/// "Under noise").
+#[test]
+fn the_filter_follows_a_panda_and_go1s_legs() {
+    fn check(name: &str, n: usize, r: &Run) {
+        print(name, n, r);
+        let at = format!("{name}, start {n}");
+        assert_eq!(r.restarts, (0, 0), "{at}");
+        assert!(
+            r.refused.0 <= 1 && r.refused.1 <= 1,
+            "{at}: {:?}",
+            r.refused
+        );
+        assert!(
+            5.0 * r.filter.all.median <= r.observer.all.median,
+            "{at}: {:e} against (38)'s {:e}",
+            r.filter.all.median,
+            r.observer.all.median
+        );
+        assert!(r.filter.clean.max <= 0.1, "{at}: {:e}", r.filter.clean.max);
+    }
+    let panda = Panda::<f64>::new();
+    for (n, &start) in starts::<_, 7, 6>(&panda, None, 4).iter().enumerate() {
+        check("Panda", n, &run::<_, 7, 6>(&panda, start, 7 + n as u64));
+    }
+    let go1 = Go1::<f64>::new();
+    for (n, &start) in starts::<_, 12, 6>(&go1, None, 3).iter().enumerate() {
+        check("Go1", n, &run::<_, 12, 6>(&go1, start, 7 + n as u64));
+    }
+}
