@@ -1,6 +1,6 @@
 //! Runs an observer over a sampled trajectory and measures its error.
 
-use moreau::{Model, Observer};
+use moreau::{Model, Observer, ObserverError};
 use nalgebra::SVector;
 
 use super::plot::Result;
@@ -15,7 +15,8 @@ pub struct Estimates<const N: usize> {
 }
 
 /// Feeds the measured positions of `reference` (from the second sample on)
-/// to `observer`, which was started at the first sample.
+/// to `observer`, which was started at the first sample; a sample it
+/// refuses as an outlier keeps the estimate it had.
 pub fn run<O, M, const N: usize, const K: usize, const NU: usize>(
     model: &M,
     observer: &mut O,
@@ -28,7 +29,13 @@ where
     let u = SVector::<f64, NU>::zeros();
     let mut v = vec![observer.estimate().v];
     for (t, q) in reference.t.iter().zip(&reference.measured).skip(1) {
-        v.push(observer.update(model, *t, q, &u)?.v);
+        match observer.update(model, *t, q, &u) {
+            Ok(e) => v.push(e.v),
+            // a sample refused as an outlier: the estimate is kept, as
+            // the estimator kept it
+            Err(ObserverError::Outlier { .. }) => v.push(observer.estimate().v),
+            Err(e) => return Err(e.into()),
+        }
     }
     let error = v
         .iter()
