@@ -169,6 +169,8 @@ where
     }
 }
 
+/// One line per run: both estimators' figures, the filter's NEES, the
+/// restarts and refusals.
 fn print(name: &str, n: usize, r: &Run) {
     eprintln!(
         "{name}, start {n}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}, velocity NEES median {:.2}, restarts {} refused {}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.2e}, restarts {} refused {}",
