@@ -14,7 +14,7 @@ use moreau::{
 mod common;
 
 use common::runs::{
-    Gauss, Reference, Scored, example_1_run, example_1_starts, figures, measure,
+    Gauss, Reference, Scored, example_1_run, example_1_starts, figures, measure, observe_counting,
     random_example_1_starts, reference, score,
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
@@ -1233,21 +1233,8 @@ where
     O: Observer<M, N, K>,
     M: Model<N, K, Scalar = f64>,
 {
-    let mut estimates = vec![estimator.estimate()];
-    let (mut restarts, mut refused) = (0, 0);
-    for (s, q) in data.samples.iter().zip(measured).skip(1) {
-        match estimator.update(model, s.t, q, u) {
-            Ok(e) => {
-                restarts += usize::from(estimator.report().restart.is_some());
-                estimates.push(e);
-            }
-            Err(ObserverError::Outlier { .. }) => {
-                refused += 1;
-                estimates.push(estimator.estimate());
-            }
-            Err(e) => panic!("t = {}: {e:?}", s.t),
-        }
-    }
+    let (estimates, restarts, refused) =
+        observe_counting(estimator, model, (data, measured), u, |_, _| {});
     Counted {
         scored: score(data, &estimates, window),
         restarts,

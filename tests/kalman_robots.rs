@@ -15,10 +15,10 @@
 
 mod common;
 
-use common::runs::{Gauss, Reference, Scored, brackets, measure, reference, score};
+use common::runs::{Gauss, Scored, brackets, measure, observe_counting, reference, score};
 use moreau::{
-    Estimate, KalmanParams, Model, Observer, ObserverError, ObserverParams, ReducedOrder,
-    SaltationKalman, Sensitivities, tune_process_noise,
+    KalmanParams, Model, ObserverParams, ReducedOrder, SaltationKalman, Sensitivities,
+    tune_process_noise,
 };
 use nalgebra::SVector;
 
@@ -68,39 +68,6 @@ where
     starts
 }
 
-/// Every update of `estimator` over the run; counts its restarts and the
-/// samples it refused as outliers (the estimate held there); `each` sees
-/// the estimator after every accepted update.
-fn observe<M, O, const N: usize, const K: usize>(
-    estimator: &mut O,
-    model: &M,
-    (data, measured): (&Reference<N>, &[SVector<f64, N>]),
-    mut each: impl FnMut(usize, &O),
-) -> (Vec<Estimate<f64, N>>, usize, usize)
-where
-    M: Model<N, K, Scalar = f64, Input: Default>,
-    O: Observer<M, N, K>,
-{
-    let u = M::Input::default();
-    let mut estimates = vec![estimator.estimate()];
-    let (mut restarts, mut refused) = (0, 0);
-    for (j, (s, q)) in data.samples.iter().zip(measured).enumerate().skip(1) {
-        match estimator.update(model, s.t, q, &u) {
-            Ok(e) => {
-                restarts += usize::from(estimator.report().restart.is_some());
-                estimates.push(e);
-                each(j, estimator);
-            }
-            Err(ObserverError::Outlier { .. }) => {
-                refused += 1;
-                estimates.push(estimator.estimate());
-            }
-            Err(e) => panic!("{}, t = {}: {e:?}", M::INFO.name, s.t),
-        }
-    }
-    (estimates, restarts, refused)
-}
-
 /// Both estimators on the plant's run from `start`, measured with the
 /// noise seed `seed`, the filter with the default knobs.
 fn run<M, const N: usize, const K: usize>(
@@ -124,7 +91,8 @@ fn run_with<M, const N: usize, const K: usize>(
 where
     M: Sensitivities<N, K, Scalar = f64, Input: Default>,
 {
-    let data = reference(model, start, 1e-5, 100, WINDOW.1, &M::Input::default());
+    let u = M::Input::default();
+    let data = reference(model, start, 1e-5, 100, WINDOW.1, &u);
     let fastest = data.samples.iter().map(|s| s.v.amax()).fold(0.0, f64::max);
     assert!(
         fastest < VELOCITY_BOUND,
@@ -137,7 +105,7 @@ where
         SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros()).unwrap();
     let mut nees = Vec::new();
     let (estimates, f_restarts, f_refused) =
-        observe(&mut filter, model, (&data, &measured), |j, f| {
+        observe_counting(&mut filter, model, (&data, &measured), &u, |j, f| {
             let s = &data.samples[j];
             if s.t >= WINDOW.0 && !bracket[j] {
                 let e = s.v - f.estimate().v;
@@ -158,7 +126,7 @@ where
     )
     .unwrap();
     let (estimates, o_restarts, o_refused) =
-        observe(&mut observer, model, (&data, &measured), |_, _| {});
+        observe_counting(&mut observer, model, (&data, &measured), &u, |_, _| {});
     nees.sort_by(f64::total_cmp);
     Run {
         filter: filter_scored,

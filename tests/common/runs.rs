@@ -2,7 +2,7 @@
 //! for an estimator, seeded Gaussian measurement noise, and the error
 //! figures (`tests/observer.rs`, `tests/kalman.rs`).
 
-use moreau::{Estimate, Model, MoreauJean, State, StepParams};
+use moreau::{Estimate, Model, MoreauJean, Observer, ObserverError, State, StepParams};
 use moreau_models::Parabola;
 use nalgebra::{SVector, Vector2};
 
@@ -74,6 +74,41 @@ pub fn measure<const N: usize>(
         .iter()
         .map(|s| s.q + SVector::from_fn(|_, _| sigma * gauss.normal()))
         .collect()
+}
+
+/// Every update of `estimator` over the run, the estimate held on a
+/// sample it refuses as an outlier; counts its restarts
+/// (`UpdateReport::restart`) and the refused samples, and hands the
+/// estimator after each accepted update, with the sample's index, to
+/// `each`. Any other error fails the test.
+pub fn observe_counting<O, M, const N: usize, const K: usize>(
+    estimator: &mut O,
+    model: &M,
+    (data, measured): (&Reference<N>, &[SVector<f64, N>]),
+    u: &M::Input,
+    mut each: impl FnMut(usize, &O),
+) -> (Vec<Estimate<f64, N>>, usize, usize)
+where
+    O: Observer<M, N, K>,
+    M: Model<N, K, Scalar = f64>,
+{
+    let mut estimates = vec![estimator.estimate()];
+    let (mut restarts, mut refused) = (0, 0);
+    for (j, (s, q)) in data.samples.iter().zip(measured).enumerate().skip(1) {
+        match estimator.update(model, s.t, q, u) {
+            Ok(e) => {
+                restarts += usize::from(estimator.report().restart.is_some());
+                estimates.push(e);
+                each(j, estimator);
+            }
+            Err(ObserverError::Outlier { .. }) => {
+                refused += 1;
+                estimates.push(estimator.estimate());
+            }
+            Err(e) => panic!("{}, t = {}: {e:?}", M::INFO.name, s.t),
+        }
+    }
+    (estimates, restarts, refused)
 }
 
 /// `|v − v̂|` at every sample.

@@ -272,6 +272,18 @@ where
         mass: &Ldlt<T, N>,
     ) -> Result<IndexSet<K>, T> {
         let w1 = piece.w1;
+        // only a constraint already separating can have lifted off: the
+        // common piece, resting or sliding with no normal speed, needs no
+        // forces and no law at its end
+        let mut separating = IndexSet::<K>::EMPTY;
+        for i in held.iter().filter(|&i| i < K) {
+            if jac.row(i).dot(&w1.transpose()) > T::zero() {
+                separating.insert(i);
+            }
+        }
+        if separating.is_empty() {
+            return Ok(IndexSet::EMPTY);
+        }
         // (the forces at `sat(w)`, as the interval takes them)
         let forces = self.model.forces(
             self.t0 + piece.s0 + piece.h,
@@ -292,15 +304,10 @@ where
         };
         let sqrt_eps = T::default_epsilon().sqrt();
         let mut lifted = IndexSet::EMPTY;
-        for i in held.iter().filter(|&i| i < K) {
-            let row = jac.row(i);
-            let scale = row.norm() * accel.norm() + jdot_w[i].abs();
+        for i in separating.iter() {
+            let scale = jac.row(i).norm() * accel.norm() + jdot_w[i].abs();
             let beyond = sqrt_eps * scale;
-            if law.lambda[i] == T::zero()
-                && law.w[i] > beyond
-                && b[i] > beyond
-                && row.dot(&w1.transpose()) > T::zero()
-            {
+            if law.lambda[i] == T::zero() && law.w[i] > beyond && b[i] > beyond {
                 lifted.insert(i);
             }
         }
