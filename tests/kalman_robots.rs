@@ -15,12 +15,15 @@
 
 mod common;
 
-use common::runs::{Gauss, Scored, brackets, measure, observe_counting, reference, score};
+use common::runs::{
+    Gauss, Reference, Scored, brackets, measure, observe_counting, reference, score,
+};
 use moreau::{
     KalmanParams, Model, ObserverParams, ReducedOrder, SaltationKalman, Sensitivities,
     tune_process_noise,
 };
 use nalgebra::SVector;
+use std::sync::OnceLock;
 
 moreau::model!(file = "examples/ur5_table.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
@@ -68,23 +71,48 @@ where
     starts
 }
 
-/// Both estimators on the plant's run from `start`, measured with the
-/// noise seed `seed`, the filter with the default knobs.
-fn run<M, const N: usize, const K: usize>(
+/// The plant's run from `start` (Moreau–Jean at `τ = 1e-5`, every
+/// hundredth state kept: 1 kHz), checked against the velocity bound.
+fn plant_run<M, const N: usize, const K: usize>(
     model: &M,
     start: (SVector<f64, N>, SVector<f64, N>),
-    seed: u64,
-) -> Run
+) -> Reference<N>
+where
+    M: Model<N, K, Scalar = f64, Input: Default>,
+{
+    let data = reference(model, start, 1e-5, 100, WINDOW.1, &M::Input::default());
+    let fastest = data.samples.iter().map(|s| s.v.amax()).fold(0.0, f64::max);
+    assert!(
+        fastest < VELOCITY_BOUND,
+        "{}: {fastest} rad/s",
+        M::INFO.name
+    );
+    data
+}
+
+/// The plant's run from the Panda's start `n` of four, made once for the
+/// two tests that score the filter on it (each run takes about 10 s).
+fn panda_run(n: usize) -> &'static Reference<7> {
+    static RUNS: [OnceLock<Reference<7>>; 4] = [const { OnceLock::new() }; 4];
+    RUNS[n].get_or_init(|| {
+        let panda = Panda::<f64>::new();
+        plant_run::<_, 7, 6>(&panda, starts::<_, 7, 6>(&panda, None, 4)[n])
+    })
+}
+
+/// Both estimators on the plant's run `data`, measured with the noise seed
+/// `seed`, the filter with the default knobs.
+fn run<M, const N: usize, const K: usize>(model: &M, data: &Reference<N>, seed: u64) -> Run
 where
     M: Sensitivities<N, K, Scalar = f64, Input: Default>,
 {
-    run_with(model, start, seed, KalmanParams::new(VELOCITY_BOUND, SIGMA))
+    run_with(model, data, seed, KalmanParams::new(VELOCITY_BOUND, SIGMA))
 }
 
 /// [`run`] with the filter's knobs `params`.
 fn run_with<M, const N: usize, const K: usize>(
     model: &M,
-    start: (SVector<f64, N>, SVector<f64, N>),
+    data: &Reference<N>,
     seed: u64,
     params: KalmanParams<f64, N>,
 ) -> Run
@@ -92,20 +120,13 @@ where
     M: Sensitivities<N, K, Scalar = f64, Input: Default>,
 {
     let u = M::Input::default();
-    let data = reference(model, start, 1e-5, 100, WINDOW.1, &u);
-    let fastest = data.samples.iter().map(|s| s.v.amax()).fold(0.0, f64::max);
-    assert!(
-        fastest < VELOCITY_BOUND,
-        "{}: {fastest} rad/s",
-        M::INFO.name
-    );
-    let measured = measure(&data, SIGMA, seed);
-    let bracket = brackets(&data);
+    let measured = measure(data, SIGMA, seed);
+    let bracket = brackets(data);
     let mut filter =
         SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros()).unwrap();
     let mut nees = Vec::new();
     let (estimates, f_restarts, f_refused) =
-        observe_counting(&mut filter, model, (&data, &measured), &u, |j, f| {
+        observe_counting(&mut filter, model, (data, &measured), &u, |j, f| {
             let s = &data.samples[j];
             if s.t >= WINDOW.0 && !bracket[j] {
                 let e = s.v - f.estimate().v;
@@ -117,7 +138,7 @@ where
                 nees.push(e.dot(&chol.solve(&e)));
             }
         });
-    let filter_scored = score(&data, &estimates, WINDOW);
+    let filter_scored = score(data, &estimates, WINDOW);
     let mut observer = ReducedOrder::<f64, N, K>::new(
         ObserverParams::new(20.0, VELOCITY_BOUND).with_noise(SIGMA),
         0.0,
@@ -126,11 +147,11 @@ where
     )
     .unwrap();
     let (estimates, o_restarts, o_refused) =
-        observe_counting(&mut observer, model, (&data, &measured), &u, |_, _| {});
+        observe_counting(&mut observer, model, (data, &measured), &u, |_, _| {});
     nees.sort_by(f64::total_cmp);
     Run {
         filter: filter_scored,
-        observer: score(&data, &estimates, WINDOW),
+        observer: score(data, &estimates, WINDOW),
         restarts: (f_restarts, o_restarts),
         refused: (f_refused, o_refused),
         nees_median: nees[nees.len() / 2],
@@ -208,7 +229,7 @@ fn the_filter_follows_a_ur5_onto_and_off_a_table() {
     let model = Ur5Table::<f64>::new();
     let starts = starts::<_, 6, 1>(&model, Some(Ur5Table::<f64>::initial_state()), 6);
     for (n, &start) in starts.iter().enumerate() {
-        let r = run::<_, 6, 1>(&model, start, 7 + n as u64);
+        let r = run::<_, 6, 1>(&model, &plant_run::<_, 6, 1>(&model, start), 7 + n as u64);
         print("UR5 on a table", n, &r);
         let at = format!("start {n}");
         assert_steady_and_ahead(&at, &r, 20.0);
@@ -255,12 +276,17 @@ fn the_filter_follows_a_panda_and_go1s_legs() {
         assert!(r.filter.clean.max <= 0.1, "{at}: {:e}", r.filter.clean.max);
     }
     let panda = Panda::<f64>::new();
-    for (n, &start) in starts::<_, 7, 6>(&panda, None, 4).iter().enumerate() {
-        check("Panda", n, &run::<_, 7, 6>(&panda, start, 7 + n as u64));
+    for n in 0..4 {
+        check(
+            "Panda",
+            n,
+            &run::<_, 7, 6>(&panda, panda_run(n), 7 + n as u64),
+        );
     }
     let go1 = Go1::<f64>::new();
     for (n, &start) in starts::<_, 12, 6>(&go1, None, 3).iter().enumerate() {
-        check("Go1", n, &run::<_, 12, 6>(&go1, start, 7 + n as u64));
+        let data = plant_run::<_, 12, 6>(&go1, start);
+        check("Go1", n, &run::<_, 12, 6>(&go1, &data, 7 + n as u64));
     }
 }
 
@@ -283,10 +309,9 @@ fn the_filter_follows_a_panda_and_go1s_legs() {
 #[test]
 fn process_noise_tuned_on_one_panda_record_holds_on_others() {
     let panda = Panda::<f64>::new();
-    let starts = starts::<_, 7, 6>(&panda, None, 4);
     let u = SVector::zeros();
-    let record = reference(&panda, starts[0], 1e-5, 100, WINDOW.1, &u);
-    let measured = measure(&record, SIGMA, 1000);
+    let record = panda_run(0);
+    let measured = measure(record, SIGMA, 1000);
     let t: Vec<f64> = record.samples.iter().map(|s| s.t).collect();
     let tuned = tune_process_noise::<_, _, 7, 6>(
         &panda,
@@ -303,9 +328,9 @@ fn process_noise_tuned_on_one_panda_record_holds_on_others() {
         tuned.factors, tuned.log_likelihood, tuned.evaluations
     );
     let median = chi_square_median(7);
-    for (n, &start) in starts.iter().enumerate().skip(1) {
-        let defaults = run::<_, 7, 6>(&panda, start, 7 + n as u64);
-        let r = run_with::<_, 7, 6>(&panda, start, 7 + n as u64, tuned.params);
+    for n in 1..4 {
+        let defaults = run::<_, 7, 6>(&panda, panda_run(n), 7 + n as u64);
+        let r = run_with::<_, 7, 6>(&panda, panda_run(n), 7 + n as u64, tuned.params);
         eprintln!(
             "Panda, start {n}: NEES median {:.2} tuned, {:.2} with the defaults; median error {:.2e} tuned, {:.2e} with the defaults",
             r.nees_median, defaults.nees_median, r.filter.all.median, defaults.filter.all.median
