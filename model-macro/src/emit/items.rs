@@ -220,6 +220,12 @@ impl Emitter<'_, '_> {
             let (mm, c, g, f, h, j) = (&m[0], &m[1], &m[2], &m[3], &m[4], &m[5]);
             quote!(::moreau::__private::Terms { mass: #mm, coriolis: #c, gravity: #g, forces: #f, gaps: #h, jacobian: #j })
         });
+        let hint = |qs: &[Quantity]| self.inline(Scalar::Model, qs);
+        let (i_mass, i_coriolis, i_gravity) = (hint(&[Mass]), hint(&[Coriolis]), hint(&[Gravity]));
+        let (i_forces, i_gaps, i_jacobian) = (hint(&[Force]), hint(&[Gap]), hint(&[Jacobian]));
+        let (i_dynamics, i_contact) = (hint(&[Mass, Force]), hint(&[Gap, Jacobian]));
+        let i_linearization = hint(&[Mass, Force, ForceDq, ForceDv]);
+        let i_eval = hint(&Quantity::EVAL);
         let info = self.info();
         let structure = self.structure();
         let parameters = self.parameter_arms();
@@ -233,28 +239,28 @@ impl Emitter<'_, '_> {
                 const INFO: ::moreau::__private::ModelInfo<#n, #k> = #info;
                 const STRUCTURE: ::moreau::__private::Structure = #structure;
 
-                #[inline]
+                #i_mass
                 fn mass(&self, #q: &#vec_n) -> #mat_nn { #mass }
-                #[inline]
+                #i_coriolis
                 fn coriolis(&self, #q: &#vec_n, #v: &#vec_n) -> #mat_nn { #coriolis }
-                #[inline]
+                #i_gravity
                 fn gravity(&self, #q: &#vec_n) -> #vec_n { #gravity }
-                #[inline]
+                #i_forces
                 fn forces(&self, #t: T, #q: &#vec_n, #v: &#vec_n, #u: &#input) -> #vec_n { #forces }
-                #[inline]
+                #i_gaps
                 fn gaps(&self, #q: &#vec_n) -> #vec_k { #gaps }
-                #[inline]
+                #i_jacobian
                 fn gap_jacobian(&self, #q: &#vec_n) -> #mat_kn { #jacobian }
                 #[inline]
                 fn restitution(&self) -> #vec_k { self.restitution }
                 #parameters
-                #[inline]
+                #i_dynamics
                 fn dynamics(&self, #t: T, #q: &#vec_n, #v: &#vec_n, #u: &#input) -> (#mat_nn, #vec_n) { #dynamics }
-                #[inline]
+                #i_linearization
                 fn linearization(&self, #t: T, #q: &#vec_n, #v: &#vec_n, #u: &#input) -> ::moreau::__private::Linearization<T, #n> { #linearization }
-                #[inline]
+                #i_contact
                 fn contact(&self, #q: &#vec_n) -> (#vec_k, #mat_kn) { #contact }
-                #[inline]
+                #i_eval
                 fn eval(&self, #t: T, #q: &#vec_n, #v: &#vec_n, #u: &#input) -> ::moreau::__private::Terms<T, #n, #k> { #eval }
             }
         }
@@ -292,13 +298,17 @@ impl Emitter<'_, '_> {
         let (q, v, _, _) = args();
         let (vec_n, mat_nn, mat_kn) = (vector(n), mat(n, n), mat(k, n));
         let (mass_dq, jacobian_dq) = (self.one(MassDq), self.one(JacobianDq));
+        let (i_mass_dq, i_jacobian_dq) = (
+            self.inline(Scalar::Model, &[MassDq]),
+            self.inline(Scalar::Model, &[JacobianDq]),
+        );
         let (n, k) = (int(n), int(k));
         quote! {
             #[allow(non_snake_case, unused_variables, clippy::all)]
             impl<#bound> ::moreau::__private::Sensitivities<#n, #k> for #name<T> {
-                #[inline]
+                #i_mass_dq
                 fn mass_dq(&self, #q: &#vec_n, #v: &#vec_n) -> #mat_nn { #mass_dq }
-                #[inline]
+                #i_jacobian_dq
                 fn jacobian_dq(&self, #q: &#vec_n, #v: &#vec_n) -> #mat_kn { #jacobian_dq }
             }
         }
@@ -312,15 +322,18 @@ impl Emitter<'_, '_> {
         let (q, v, t, u) = args();
         let over = |qs: &[Quantity]| self.method_body_over(Scalar::Enclosure, qs, |m| m[0].clone());
         let (mass, coriolis, forces_dv) = (over(&[Mass]), over(&[Coriolis]), over(&[ForceDv]));
+        let hint = |qs: &[Quantity]| self.inline(Scalar::Enclosure, qs);
+        let (i_mass, i_coriolis, i_forces_dv) =
+            (hint(&[Mass]), hint(&[Coriolis]), hint(&[ForceDv]));
         let (n, k) = (int(n), int(k));
         quote! {
             #[allow(non_snake_case, unused_variables, clippy::all)]
             impl<#bound> ::moreau::__private::Enclosure<#n, #k> for #name<T> {
-                #[inline]
+                #i_mass
                 fn mass_enclosure<I: ::moreau::__private::Enclose>(&self, #q: &[I; #n]) -> [[I; #n]; #n] { #mass }
-                #[inline]
+                #i_coriolis
                 fn coriolis_enclosure<I: ::moreau::__private::Enclose>(&self, #q: &[I; #n], #v: &[I; #n]) -> [[I; #n]; #n] { #coriolis }
-                #[inline]
+                #i_forces_dv
                 fn forces_dv_enclosure<I: ::moreau::__private::Enclose>(&self, #t: I, #q: &[I; #n], #v: &[I; #n], #u: &[I]) -> [[I; #n]; #n] { #forces_dv }
             }
         }

@@ -197,3 +197,21 @@ fn long_bodies_are_cut_into_bounded_parts() {
         assert_eq!(ranges, body.lets.len());
     });
 }
+
+/// A method is hinted `#[inline]` when its body has at most `INLINE_OPS`
+/// operations: every method of Example 1; of the 12-link chain, `mass`
+/// (277 operations) but not `eval` (1 103) nor `linearization` (1 707).
+#[test]
+fn only_short_bodies_are_hinted_inline() {
+    let hinted = |stem: &str, method: &str| {
+        let code = shipped(stem, |model, lowered| Emitter::new(model, lowered).items()).to_string();
+        let at = code.find(&format!("fn {method} ")).unwrap();
+        code[..at].trim_end().ends_with("# [inline]")
+    };
+    for method in ["mass", "eval", "linearization", "mass_dq", "mass_enclosure"] {
+        assert!(hinted("parabola", method), "parabola {method}");
+    }
+    assert!(hinted("chains/chain12", "mass"));
+    assert!(!hinted("chains/chain12", "eval"));
+    assert!(!hinted("chains/chain12", "linearization"));
+}
