@@ -125,14 +125,18 @@ impl<'a, 'm> Emitter<'a, 'm> {
         }
     }
 
+    /// The instruction list of the code over `scalar`.
+    fn schedule(&self, scalar: Scalar) -> &Schedule {
+        match scalar {
+            Scalar::Model => &self.full,
+            Scalar::Enclosure => &self.enclosed,
+        }
+    }
+
     /// The body computing every entry of `qs` over `scalar`.
     fn body(&self, scalar: Scalar, qs: &[Quantity]) -> (Vec<usize>, Body) {
         let indices = self.outputs.indices(qs);
-        let schedule = match scalar {
-            Scalar::Model => &self.full,
-            Scalar::Enclosure => &self.enclosed,
-        };
-        let body = body::build(self.model, schedule, &self.outputs, &indices);
+        let body = body::build(self.model, self.schedule(scalar), &self.outputs, &indices);
         (indices, body)
     }
 
@@ -153,18 +157,18 @@ impl<'a, 'm> Emitter<'a, 'm> {
     /// (the UR5's `linearization` 10 392, the Panda's `eval` 10 106), where
     /// the call is lost in the body, and the hint only costs compile time:
     /// rustc copies an `#[inline]` generic into every codegen unit that
-    /// calls it, where LLVM optimises each copy again. Without it the body is compiled once per crate. Measured on
-    /// the test binaries `robots_casadi` and `kalman_robots` built together
-    /// (`cargo test --release --no-run`, 2 cores): 370 s of CPU with every
+    /// calls it, where LLVM optimises each copy again. Without it the body
+    /// is compiled once per crate. Measured on the test binaries
+    /// `robots_casadi` and `kalman_robots` built together (`cargo test
+    /// --release --no-run`, 2 cores): 370 s of CPU with every
     /// method hinted, 326 s without the hint above 1 000 operations, and
     /// the run time of `kalman_robots`'s robots unchanged (43 to 48 s
     /// before, 42 to 43 s after, for `the_filter_follows_the_other_robots`).
     fn inline(&self, scalar: Scalar, qs: &[Quantity]) -> TokenStream {
-        let schedule = match scalar {
-            Scalar::Model => &self.full,
-            Scalar::Enclosure => &self.enclosed,
-        };
-        let ops = schedule.restrict(&self.outputs.indices(qs)).op_count();
+        let ops = self
+            .schedule(scalar)
+            .restrict(&self.outputs.indices(qs))
+            .op_count();
         if ops <= INLINE_OPS {
             quote!(#[inline])
         } else {
