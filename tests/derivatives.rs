@@ -8,7 +8,7 @@
 //!    1e-12, relative as `common::relative_error` defines it (for C, ∂F/∂v
 //!    and ∂(M v)/∂q, sums of (∂M/∂q) v, to a scale of at least
 //!    max|M| max|v|; `common::casadi::against_casadi`). The robots of
-//!    `tests/robots/` go through the same comparison in `tests/robots_casadi.rs`.
+//!    `tests/robots/` go through the same comparison in `tests/robots/casadi.rs`.
 //! 2. What needs no CasADi: M symmetric positive definite, the skew
 //!    symmetry of Ṁ − 2C (property (P1)), J and the force Jacobians against
 //!    central finite differences.

@@ -16,7 +16,7 @@ continuous joint too) the script writes:
   its linear Jacobian ``∂p/∂q`` (from the frame Jacobian in the
   LOCAL_WORLD_ALIGNED convention: ``J_lin − [R r]× J_ang``).
 
-The Rust test ``tests/pinocchio.rs`` compares the generated code with these
+The Rust test ``tests/robots/pinocchio.rs`` compares the generated code with these
 numbers to 1e-10 relative. The files are JSON, one per robot, in
 ``tests/fixtures/pinocchio/``::
 

@@ -1,4 +1,4 @@
-//! URDF import beyond the dynamics (which `tests/pinocchio.rs` checks):
+//! URDF import beyond the dynamics (which `tests/robots/pinocchio.rs` checks):
 //! joint limits turned into constraints on request. The limits are those
 //! written in `tests/robots/urdf/synthetic/slider_arm.urdf`: `slide` in
 //! [-1, 1], `shoulder` in [-3, 3].

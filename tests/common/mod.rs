@@ -7,6 +7,7 @@ pub mod runs;
 
 use std::path::PathBuf;
 
+use moreau::ModelInfo;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde_json::Value;
 
@@ -96,4 +97,21 @@ pub fn central<const N: usize, const R: usize>(
     plus[j] += step;
     minus[j] -= step;
     (f(&plus) - f(&minus)) / (2.0 * step)
+}
+
+/// Two models' names, inputs and operation counts agree (everything in
+/// `ModelInfo` but the model text, which differs with the front end).
+pub fn same_info<const N: usize, const K: usize>(a: &ModelInfo<N, K>, b: &ModelInfo<N, K>) {
+    let key = |i: &ModelInfo<N, K>| {
+        (
+            i.name,
+            i.coordinates,
+            i.velocities,
+            i.constraints,
+            i.parameters,
+            i.inputs,
+            i.op_count,
+        )
+    };
+    assert_eq!(key(a), key(b));
 }

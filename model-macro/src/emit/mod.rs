@@ -159,11 +159,12 @@ impl<'a, 'm> Emitter<'a, 'm> {
     /// rustc copies an `#[inline]` generic into every codegen unit that
     /// calls it, where LLVM optimises each copy again. Without it the body
     /// is compiled once per crate. Measured on the test binaries
-    /// `robots_casadi` and `kalman_robots` built together (`cargo test
-    /// --release --no-run`, 2 cores): 370 s of CPU with every
-    /// method hinted, 326 s without the hint above 1 000 operations, and
-    /// the run time of `kalman_robots`'s robots unchanged (43 to 48 s
-    /// before, 42 to 43 s after, for `the_filter_follows_the_other_robots`).
+    /// `robots_casadi` and `kalman_robots` (since merged into `robots`)
+    /// built together (`cargo test --release --no-run`, 2 cores): 370 s of
+    /// CPU with every method hinted, 326 s without the hint above 1 000
+    /// operations, and the run time of `kalman_robots`'s robots unchanged
+    /// (43 to 48 s before, 42 to 43 s after, for
+    /// `the_filter_follows_the_other_robots`).
     fn inline(&self, scalar: Scalar, qs: &[Quantity]) -> TokenStream {
         let ops = self
             .schedule(scalar)

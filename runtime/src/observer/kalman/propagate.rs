@@ -254,7 +254,7 @@ where
     /// at every stage; projecting the end onto its manifold took that
     /// separating speed back out of the estimate, and the covariance,
     /// projected with it, kept the samples from putting it back. On a
-    /// UR5 swinging its tool off a table (`tests/kalman_robots.rs`), one
+    /// UR5 swinging its tool off a table (`tests/robots/kalman.rs`), one
     /// such projection left the joint velocities 2.2e-4 rad/s off while
     /// the filter claimed 3.1e-5, for hundreds of milliseconds; on the
     /// double pendulum's tip leaving the floor, 6.4e-5 rad/s off against

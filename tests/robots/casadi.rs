@@ -16,19 +16,12 @@
 //! not use (a YAML body on a URDF link, a locked prismatic joint, tilted
 //! gravity, `direction_x/_y/_z`, energies and an input beside the tree).
 
-mod common;
+use crate::common::casadi::{against_casadi, defaults_match};
 
-use common::casadi::{against_casadi, defaults_match};
-
-moreau::model!(file = "tests/robots/two_link.yaml");
-moreau::model!(file = "tests/robots/two_link_energies.yaml");
-moreau::model!(file = "tests/robots/slider_arm.yaml");
-moreau::model!(file = "tests/robots/slider_arm_limits.yaml");
-moreau::model!(file = "tests/robots/ur5.yaml");
-moreau::model!(file = "tests/robots/panda.yaml");
-moreau::model!(file = "tests/robots/serial_12.yaml");
-moreau::model!(file = "tests/robots/slider_arm_mixed.yaml");
-moreau::model!(file = "tests/robots/go1.yaml");
+use crate::{
+    Go1, Panda, Serial12, SliderArm, SliderArmLimits, SliderArmMixed, TwoLinkEnergies, TwoLinkTree,
+    Ur5,
+};
 
 #[test]
 fn two_link_tree_matches_casadi() {

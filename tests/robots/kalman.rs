@@ -15,9 +15,7 @@
 //! constraint Jacobians and the derivatives its saltation matrices and
 //! contact projections need come from the URDF through `model!`.
 
-mod common;
-
-use common::runs::{
+use crate::common::runs::{
     Gauss, Reference, Scored, brackets, measure, observe_counting, reference, score,
 };
 use moreau::{
@@ -27,13 +25,7 @@ use moreau::{
 use nalgebra::SVector;
 use std::sync::OnceLock;
 
-moreau::model!(file = "examples/ur5_table.yaml");
-moreau::model!(file = "tests/robots/panda.yaml");
-moreau::model!(file = "tests/robots/go1.yaml");
-moreau::model!(file = "tests/robots/two_link.yaml");
-moreau::model!(file = "tests/robots/slider_arm_limits.yaml");
-moreau::model!(file = "tests/robots/slider_arm_mixed.yaml");
-moreau::model!(file = "tests/robots/serial_12.yaml");
+use crate::{Go1, Panda, Serial12, SliderArmLimits, SliderArmMixed, TwoLinkTree, Ur5Table};
 
 const SIGMA: f64 = 1e-4;
 const WINDOW: (f64, f64) = (1.0, 3.0);

@@ -18,19 +18,13 @@
 //! recursions (`∂F/∂q`, `∂F/∂v`, `∂(M v)/∂q`, `∂(J v)/∂q`) against central
 //! differences, and `Ṁ − 2C` skew-symmetric.
 
-mod common;
-
-use common::central;
+use crate::common::central;
 
 use moreau::{Model, Sensitivities};
 use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
 
-moreau::model!(file = "tests/robots/ur5.yaml");
-moreau::model!(file = "tests/robots/panda.yaml");
-moreau::model!(file = "tests/robots/slider_arm.yaml");
-moreau::model!(file = "tests/robots/serial_12.yaml");
-moreau::model!(file = "tests/robots/go1.yaml");
+use crate::{Go1, Panda, Serial12, SliderArm, Ur5};
 
 /// `tests/robots/ur5.yaml` written inline, the URDF named by `urdf = "...";`.
 mod inline {
@@ -52,7 +46,7 @@ mod inline {
 const RTOL: f64 = 1e-10;
 
 fn fixture(robot: &str) -> Value {
-    let path = common::root().join(format!("tests/fixtures/pinocchio/{robot}.json"));
+    let path = crate::common::root().join(format!("tests/fixtures/pinocchio/{robot}.json"));
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     serde_json::from_str(&text).expect("fixture is JSON")
