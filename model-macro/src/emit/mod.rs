@@ -140,11 +140,16 @@ impl<'a, 'm> Emitter<'a, 'm> {
         (indices, body)
     }
 
+    /// Number of operations of the code computing `qs` over `scalar`.
+    fn ops(&self, scalar: Scalar, qs: &[Quantity]) -> usize {
+        self.schedule(scalar)
+            .restrict(&self.outputs.indices(qs))
+            .op_count()
+    }
+
     /// Number of operations of the fused evaluation (`ModelInfo::op_count`).
     fn op_count(&self) -> usize {
-        self.full
-            .restrict(&self.outputs.indices(&Quantity::EVAL))
-            .op_count()
+        self.ops(Scalar::Model, &Quantity::EVAL)
     }
 
     /// `#[inline]` for a method computing `qs` over `scalar` when its body
@@ -166,11 +171,7 @@ impl<'a, 'm> Emitter<'a, 'm> {
     /// (43 to 48 s before, 42 to 43 s after, for
     /// `the_filter_follows_the_other_robots`).
     fn inline(&self, scalar: Scalar, qs: &[Quantity]) -> TokenStream {
-        let ops = self
-            .schedule(scalar)
-            .restrict(&self.outputs.indices(qs))
-            .op_count();
-        if ops <= INLINE_OPS {
+        if self.ops(scalar, qs) <= INLINE_OPS {
             quote!(#[inline])
         } else {
             TokenStream::new()
