@@ -10,9 +10,12 @@
 use moreau::{Estimate, Model, Observer, ObserverParams, ReducedOrder};
 mod common;
 
-use common::runs::{Reference, Scored, example_1_starts, measure, reference, score};
+use common::runs::{
+    Reference, Scored, brackets, errors, example_1_starts, first_at_or_after, measure,
+    random_example_1_starts, reference, score,
+};
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 /// (38) with `l_d = 10`, `C_v = 20`, told `σ`, from the first measurement
 /// and `v̂(0) = 0`; returns the estimates, the initial one first.
@@ -164,4 +167,106 @@ fn other_models_under_noise() {
         &[7001, 9001],
         (1.7, 3.0, 0.1),
     );
+}
+
+/// How well the noise lets a sample time an impact: the bound `B` on the
+/// velocity error an impact leaves at the sample after the two that
+/// bracket it, when its instant is known only from noisy positions.
+///
+/// Gap `i` closes at `ḣ_i = J_i v` with the normal acceleration `ḧ_i =
+/// J_i a + J̇_i v` (`a = −M⁻¹F`, the free motion; `J̇_i v` by a central
+/// difference of `J` along `v`). A position known to `σ` along the normal
+/// times the impact to `δ = σ |J_i| / |ḣ_i|`; Newton's law then restitutes
+/// a normal velocity `(1 + e_i) ḧ_i δ` off, a velocity error of that over
+/// `|J_i|` (unit mass along the normal): `B = (1 + e_i) |ḧ_i| σ / |ḣ_i|`.
+fn timing_bound(model: &Parabola<f64>, state: &moreau::State<f64, 2>, i: usize, sigma: f64) -> f64 {
+    let (q, v) = (state.q, state.v);
+    let (mass, forces) = model.dynamics(state.t, &q, &v, &SVector::zeros());
+    let a = -mass.try_inverse().expect("M invertible") * forces;
+    let eps = 1e-6;
+    let jac_rate: SMatrix<f64, 2, 2> =
+        (model.gap_jacobian(&(q + v * eps)) - model.gap_jacobian(&(q - v * eps))) / (2.0 * eps);
+    let row = model.gap_jacobian(&q).row(i).into_owned();
+    let (hd, hdd) = (
+        row.dot(&v.transpose()),
+        row.dot(&a.transpose()) + jac_rate.row(i).dot(&v.transpose()),
+    );
+    (1.0 + model.restitution()[i]) * hdd.abs() * sigma / hd.abs()
+}
+
+/// An impact (38) placed from noisy samples is placed again by the sample
+/// after it (`interval/retime.rs`), and one it missed is applied in the
+/// next interval: at the sample after the two that bracket it, the error
+/// is what the noise leaves undecided, and no more. Example 1, the four
+/// starts (noise seed `11 + n`) and the 48 random starts of
+/// `tests/kalman.rs` (seeds 555, 777, 999, 1234; noise seed `100 + n`),
+/// every plant impact in `[2, 10]` s that the noise can place within one
+/// sample (approached at `|ḣ|/|J| ≥ 2σ/τ_s`, 0.2 m/s; slower ones are
+/// undecided for more than the bracketing samples, as the issue says) and
+/// that comes to an estimate within 1e-2 of the truth (the errors (38)
+/// carries through an accumulation decay at `l_d`, not at a sample), with
+/// no other impact in the interval after it.
+///
+/// Asserted: at the first sample after the brackets, the error is at most
+/// 1e-2 or at most `2 B` (two deviations of the instant, [`timing_bound`]).
+/// Measured: 1111 such impacts; 10 leave more than 1e-2 there, at most
+/// 0.87 `B` (0.012 m/s, `B` = 0.014, approached at 0.31 m/s along the
+/// normal). On 24 more random starts (seeds 31 and 42; scratch run), 538
+/// impacts, none above `2 B`. Beyond the test, the impacts approached
+/// slower than 0.2 m/s (all 72 random starts and the four): 14 left more
+/// than 1e-2 at that sample, 12 of them below `B` and two above it (1.4
+/// and 4.7 `B`, approached at 0.047 and 0.050 m/s, where `σ/|v|` is two
+/// sampling periods).
+#[test]
+fn an_impact_is_timed_as_well_as_the_noise_allows() {
+    let model = Parabola::<f64>::new();
+    let (sigma, period) = (1e-4, 1e-3);
+    let mut runs: Vec<_> = example_1_starts()
+        .into_iter()
+        .enumerate()
+        .map(|(n, start)| (format!("start {n}"), start, 11 + n as u64))
+        .collect();
+    for seed in [555, 777, 999, 1234] {
+        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
+            runs.push((format!("seed {seed}, start {n}"), start, 100 + n as u64));
+        }
+    }
+    let (mut checked, mut above, mut worst) = (0, 0, (0.0_f64, 0.0, 0.0, 0.0));
+    let mut failed = Vec::new();
+    for (name, start, seed) in runs {
+        let data = reference(&model, start, 1e-5, 100, 10.0, &SVector::zeros());
+        let measured = measure(&data, sigma, seed);
+        let error = errors(&data, &run::<_, 2, 2>(&model, &data, &measured, sigma));
+        let bracket = brackets(&data);
+        for &(t, i, approach) in &data.impacts {
+            let first = first_at_or_after(&data, t);
+            let next = first + 1;
+            if t < 2.0 || next >= error.len() || bracket[next] || error[first - 1] >= 1e-2 {
+                continue;
+            }
+            let before = &data.samples[first - 1];
+            let normal = model.gap_jacobian(&before.q).row(i).norm();
+            if approach / normal < 2.0 * sigma / period {
+                continue;
+            }
+            let bound = timing_bound(&model, before, i, sigma);
+            checked += 1;
+            if error[next] > 1e-2 {
+                above += 1;
+                let ratio = error[next] / bound;
+                if ratio > worst.0 {
+                    worst = (ratio, error[next], bound, approach / normal);
+                }
+                if error[next] > 2.0 * bound {
+                    failed.push((name.clone(), t, error[next], bound));
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{checked} impacts; {above} leave more than 1e-2 at the sample after the brackets, at most {:.2} B ({:.3} m/s, B = {:.3}, approached at {:.3} m/s)",
+        worst.0, worst.1, worst.2, worst.3
+    );
+    assert!(checked > 1000, "{checked} impacts");
+    assert!(failed.is_empty(), "{failed:?}");
 }

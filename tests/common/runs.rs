@@ -155,7 +155,7 @@ pub struct Scored {
 }
 
 /// The first sample at or after time `t` (the number of samples if none).
-fn first_at_or_after<const N: usize>(data: &Reference<N>, t: f64) -> usize {
+pub fn first_at_or_after<const N: usize>(data: &Reference<N>, t: f64) -> usize {
     data.samples
         .iter()
         .position(|s| s.t >= t - 1e-12)
