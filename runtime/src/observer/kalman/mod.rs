@@ -989,21 +989,7 @@ where
             // UPDATE, Joseph form
             let k_q = chol.solve(&p.qq).transpose();
             let k_v = chol.solve(&p.qv).transpose();
-            let id = SMatrix::<T, N, N>::identity();
-            let b = Blocks {
-                qq: id - k_q,
-                qv: SMatrix::zeros(),
-                vq: -k_v,
-                vv: id,
-            };
-            let joseph = b.congruence_covered(&p);
-            let noise = Blocks {
-                qq: k_q * r * k_q.transpose(),
-                qv: k_q * r * k_v.transpose(),
-                vq: k_v * r * k_q.transpose(),
-                vv: k_v * r * k_v.transpose(),
-            };
-            p = joseph.add(&noise).symmetrized();
+            p = p.joseph_position_update(&k_q, &k_v, &r);
             (q_pred + k_q * y, v_pred + k_v * y)
         };
         // WRITEBACK: only a finite result replaces the state, its
