@@ -228,6 +228,45 @@ where
 /// assert_eq!((phi.entry(0, 0), phi.entry(0, 1), phi.entry(1, 0), phi.entry(1, 1)), (1.0, 0.25, 0.0, 1.0));
 /// ```
 pub fn transition<T: RealField + Copy, const N: usize>(a: &Blocks<T, N>, h: T) -> Blocks<T, N> {
+    if a.qq == SMatrix::<T, N, N>::zeros() && a.qv == SMatrix::<T, N, N>::identity() {
+        flow_transition(a, h)
+    } else {
+        general_transition(a, h)
+    }
+}
+
+/// [`transition`] of a flow's `A` (`q' = v`: `A_qq = 0`, `A_qv = I`, as
+/// [`flow_jacobian`] and [`constrained_flow_jacobian`] give it). Each
+/// Horner step `I + (h/k) A Φ` needs `A Φ = (Φ_vq, Φ_vv; A_vq Φ_qq + A_vv
+/// Φ_vq, A_vq Φ_qv + A_vv Φ_vv)`: half the block products of the general
+/// one, and (a product by an exact `0` or `1` adding nothing) the same
+/// bits for finite entries (docs/estimation-under-noise.md, "Cost
+/// re-runs": with [`Blocks::joseph_position_update`], 10 % fewer
+/// instructions per filter update in free flight on Example 1).
+fn flow_transition<T: RealField + Copy, const N: usize>(a: &Blocks<T, N>, h: T) -> Blocks<T, N> {
+    let id = Blocks::identity();
+    let c = h / nalgebra::convert::<f64, T>(4.0);
+    let mut phi = id.add(&Blocks {
+        qq: SMatrix::<T, N, N>::zeros(),
+        qv: SMatrix::<T, N, N>::identity() * c,
+        vq: a.vq * c,
+        vv: a.vv * c,
+    });
+    for k in [3.0, 2.0, 1.0] {
+        let c = h / nalgebra::convert::<f64, T>(k);
+        let (vq, vv) = (a.vq * c, a.vv * c);
+        phi = id.add(&Blocks {
+            qq: phi.vq * c,
+            qv: phi.vv * c,
+            vq: vq * phi.qq + vv * phi.vq,
+            vv: vq * phi.qv + vv * phi.vv,
+        });
+    }
+    phi
+}
+
+/// [`transition`] of any `A`, by Horner's rule on the blocks.
+fn general_transition<T: RealField + Copy, const N: usize>(a: &Blocks<T, N>, h: T) -> Blocks<T, N> {
     let scaled = |k: f64| {
         let c = h / nalgebra::convert::<f64, T>(k);
         Blocks {
@@ -513,4 +552,48 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
         dq,
         dv,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, Matrix4};
+
+    fn full(b: &Blocks<f64, 2>) -> Matrix4<f64> {
+        Matrix4::from_fn(|i, j| b.entry(i, j))
+    }
+
+    /// The flow's short path gives the general path's bits, and both the
+    /// Taylor polynomial `Σ_{j ≤ 4} (A h)^j / j!` of the full `4 × 4`
+    /// matrix; an `A` that is not a flow's takes the general path.
+    #[test]
+    fn the_transition_of_a_flow_is_the_general_one_to_the_bit() {
+        let flow = Blocks {
+            qq: Matrix2::zeros(),
+            qv: Matrix2::identity(),
+            vq: Matrix2::new(-3.0, 0.5, 1.25, -0.75),
+            vv: Matrix2::new(-0.2, 0.1, 0.05, -0.4),
+        };
+        let taylor = |a: &Blocks<f64, 2>, h: f64| {
+            let ah = full(a) * h;
+            let mut term = Matrix4::identity();
+            let mut sum = Matrix4::identity();
+            for j in 1..=4 {
+                term = term * ah / f64::from(j);
+                sum += term;
+            }
+            sum
+        };
+        for h in [1e-3, 0.37, 2.0] {
+            let short = transition(&flow, h);
+            assert_eq!(short, general_transition(&flow, h));
+            assert!((full(&short) - taylor(&flow, h)).amax() <= 1e-14 * taylor(&flow, h).amax());
+        }
+        let other = Blocks {
+            qq: Matrix2::new(0.1, 0.0, 0.0, 0.2),
+            ..flow
+        };
+        assert_eq!(transition(&other, 0.37), general_transition(&other, 0.37));
+        assert!((full(&transition(&other, 0.37)) - taylor(&other, 0.37)).amax() <= 1e-14);
+    }
 }
