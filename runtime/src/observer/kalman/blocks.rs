@@ -206,20 +206,35 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
     /// ```
     #[must_use]
     pub fn congruence_covered(&self, p: &Self) -> Self {
-        let zero = T::zero();
-        let sd_q = p.qq.diagonal().map(|d| d.max(zero).sqrt());
-        let sd_v = p.vv.diagonal().map(|d| d.max(zero).sqrt());
+        let (sd_q, sd_v) = p.deviations();
         let abs = self.abs();
         let c_q = abs.qq * sd_q + abs.qv * sd_v;
         let c_v = abs.vq * sd_q + abs.vv * sd_v;
+        self.congruence(p).cover(&c_q, &c_v)
+    }
+
+    /// The square roots of the diagonal (negative entries read as `0`),
+    /// as its position and velocity parts.
+    fn deviations(&self) -> (SVector<T, N>, SVector<T, N>) {
+        let zero = T::zero();
+        (
+            self.qq.diagonal().map(|d| d.max(zero).sqrt()),
+            self.vv.diagonal().map(|d| d.max(zero).sqrt()),
+        )
+    }
+
+    /// `self`, a congruence `B P Bᵀ`, with the cover of its rounding added
+    /// to the diagonal: `8N² ε c_i²`, `c = |B| √diag P` given as its
+    /// position and velocity parts (see
+    /// [`congruence_covered`](Self::congruence_covered)).
+    fn cover(mut self, c_q: &SVector<T, N>, c_v: &SVector<T, N>) -> Self {
         let n: T = nalgebra::convert(N as f64);
         let unit = T::default_epsilon() * nalgebra::convert(8.0) * n * n;
-        let mut out = self.congruence(p);
         for i in 0..N {
-            out.qq[(i, i)] += unit * c_q[i] * c_q[i];
-            out.vv[(i, i)] += unit * c_v[i] * c_v[i];
+            self.qq[(i, i)] += unit * c_q[i] * c_q[i];
+            self.vv[(i, i)] += unit * c_v[i] * c_v[i];
         }
-        out
+        self
     }
 
     /// The Joseph form of a Kalman update of the covariance `P` (`self`)
@@ -268,7 +283,6 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
         k_v: &SMatrix<T, N, N>,
         r: &SMatrix<T, N, N>,
     ) -> Self {
-        let zero = T::zero();
         let a = SMatrix::<T, N, N>::identity() - k_q;
         // (I − KH) P, its four blocks
         let ap_qq = a * self.qq;
@@ -284,17 +298,8 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
         }
         .symmetrized();
         // the cover of its rounding, `c = |I − KH| √diag P`
-        let sd_q = self.qq.diagonal().map(|d| d.max(zero).sqrt());
-        let sd_v = self.vv.diagonal().map(|d| d.max(zero).sqrt());
-        let c_q = a.abs() * sd_q;
-        let c_v = k_v.abs() * sd_q + sd_v;
-        let n: T = nalgebra::convert(N as f64);
-        let unit = T::default_epsilon() * nalgebra::convert(8.0) * n * n;
-        let mut covered = congruence;
-        for i in 0..N {
-            covered.qq[(i, i)] += unit * c_q[i] * c_q[i];
-            covered.vv[(i, i)] += unit * c_v[i] * c_v[i];
-        }
+        let (sd_q, sd_v) = self.deviations();
+        let covered = congruence.cover(&(a.abs() * sd_q), &(k_v.abs() * sd_q + sd_v));
         // K R Kᵀ
         let (kr_q, kr_v) = (k_q * r, k_v * r);
         let noise = Self {
