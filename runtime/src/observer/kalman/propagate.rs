@@ -78,8 +78,8 @@ use crate::validate::{self, factor_mass};
 use super::super::ObserverError;
 use super::super::interval::{Flight, Jump, Law, Tracer, fastest_approach, saturate};
 use super::saltation::{
-    Saltation, constrained_flow_jacobian, flow_jacobian, project_onto_contact, saltation,
-    transition,
+    Saltation, constrained_flow_jacobian, flow_jacobian, flow_transition, project_onto_contact,
+    saltation,
 };
 use super::{Blocks, KalmanParams};
 
@@ -417,7 +417,7 @@ where
         };
         self.held = held;
         let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
-        let phi = transition(&a, piece.h);
+        let phi = flow_transition(&a, piece.h);
         let mut p = phi.congruence_covered(&self.p).add(&noise);
         self.carry_offset(&phi);
         self.correction = (SVector::zeros(), SVector::zeros());

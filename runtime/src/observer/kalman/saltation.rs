@@ -242,8 +242,17 @@ pub fn transition<T: RealField + Copy, const N: usize>(a: &Blocks<T, N>, h: T) -
 /// one, and (a product by an exact `0` or `1` adding nothing) the same
 /// bits for finite entries (docs/estimation-under-noise.md, "Cost
 /// re-runs": with [`Blocks::joseph_position_update`], 10 % fewer
-/// instructions per filter update in free flight on Example 1).
-fn flow_transition<T: RealField + Copy, const N: usize>(a: &Blocks<T, N>, h: T) -> Blocks<T, N> {
+/// instructions per filter update in free flight on Example 1). The
+/// filter's propagation calls it directly: the Jacobians it holds are a
+/// flow's by construction, so no piece tests the blocks again.
+pub(crate) fn flow_transition<T: RealField + Copy, const N: usize>(
+    a: &Blocks<T, N>,
+    h: T,
+) -> Blocks<T, N> {
+    debug_assert!(
+        a.qq == SMatrix::<T, N, N>::zeros() && a.qv == SMatrix::<T, N, N>::identity(),
+        "not a flow's A"
+    );
     let id = Blocks::identity();
     let c = h / nalgebra::convert::<f64, T>(4.0);
     let mut phi = id.add(&Blocks {
