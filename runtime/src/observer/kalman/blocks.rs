@@ -213,6 +213,66 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
         self.congruence(p).cover(&c_q, &c_v)
     }
 
+    /// The transition of a flow whose acceleration depends on neither `q`
+    /// nor `v` over a time `h`: `Φ = (I, h I; 0, I)`.
+    ///
+    /// ```
+    /// use moreau_runtime::Blocks;
+    ///
+    /// let phi = Blocks::<f64, 2>::ballistic(0.5);
+    /// assert_eq!((phi.entry(0, 2), phi.entry(1, 3), phi.entry(2, 0), phi.entry(3, 3)), (0.5, 0.5, 0.0, 1.0));
+    /// ```
+    pub fn ballistic(h: T) -> Self {
+        Self {
+            qq: SMatrix::identity(),
+            qv: SMatrix::identity() * h,
+            vq: SMatrix::zeros(),
+            vv: SMatrix::identity(),
+        }
+    }
+
+    /// [`congruence_covered`](Self::congruence_covered) by the
+    /// [`ballistic`](Self::ballistic) transition `Φ = (I, h I; 0, I)`,
+    /// `Φ P Φᵀ` of `P` (`self`), with the products by its exact `0`, `1`
+    /// and `h I` blocks written out: each entry of a block product by them
+    /// is one product of two numbers and exact zeros, so the result is the
+    /// general form's to the bit (for finite entries). Four scaled
+    /// additions of `N × N` blocks instead of sixteen block products, and
+    /// no Jacobian to compute: the free flight of point masses under
+    /// constant forces (Example 1, the three balls, the billiard), where
+    /// the filter's propagation takes it (module `propagate`).
+    ///
+    /// ```
+    /// use moreau_runtime::Blocks;
+    /// use nalgebra::Matrix2;
+    ///
+    /// let p = Blocks {
+    ///     qq: Matrix2::new(2.0, 0.3, 0.3, 1.0),
+    ///     qv: Matrix2::new(0.5, 0.1, -0.2, 0.4),
+    ///     vq: Matrix2::new(0.5, -0.2, 0.1, 0.4),
+    ///     vv: Matrix2::new(3.0, 0.2, 0.2, 2.0),
+    /// };
+    /// let h = 1e-3;
+    /// let general = Blocks::ballistic(h).congruence_covered(&p);
+    /// assert_eq!(p.ballistic_congruence_covered(h), general);
+    /// ```
+    #[must_use]
+    pub fn ballistic_congruence_covered(&self, h: T) -> Self {
+        // Φ P, its blocks: (P_qq + h P_vq, P_qv + h P_vv; P_vq, P_vv)
+        let (x_qq, x_qv) = (self.qq + self.vq * h, self.qv + self.vv * h);
+        // times Φᵀ = (I, 0; h I, I)
+        let congruence = Self {
+            qq: x_qq + x_qv * h,
+            qv: x_qv,
+            vq: self.vq + self.vv * h,
+            vv: self.vv,
+        }
+        .symmetrized();
+        // the cover of its rounding, `c = |Φ| √diag P`
+        let (sd_q, sd_v) = self.deviations();
+        congruence.cover(&(sd_q + sd_v * h), &sd_v)
+    }
+
     /// The square roots of the diagonal (negative entries read as `0`),
     /// as its position and velocity parts.
     fn deviations(&self) -> (SVector<T, N>, SVector<T, N>) {

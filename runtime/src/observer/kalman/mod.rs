@@ -38,7 +38,11 @@
 //!      [`flow_jacobian`] at `x_0` (Runge–Kutta on the variational
 //!      equation with `A` held at the start of the piece: exact when `A`
 //!      is constant, as for Example 1 in flight, and otherwise of the
-//!      accuracy of a Jacobian frozen over at most one sampling interval),
+//!      accuracy of a Jacobian frozen over at most one sampling interval;
+//!      for a model whose acceleration depends on neither `q` nor `v` by
+//!      its structure, `Φ = (I, hI; 0, I)` exactly and the congruence is
+//!      written out, [`Blocks::ballistic_congruence_covered`], to the
+//!      general path's bits),
 //!      `Q(h)` white acceleration noise of density `diag(q_a²)` integrated
 //!      exactly for `q'' = w`: `[[h³/3, h²/2], [h²/2, h]] ⊗ diag(q_a²)`;
 //!    - an impact: `P ← Ξ P Ξᵀ`, `Ξ` the [`saltation`] matrix of Newton's
