@@ -507,6 +507,11 @@ impl<T: RealField + Copy> MoreauJean<T> {
             return forces;
         }
         let jump = v - start.v;
+        // no jump (the first Newton iterate, `ṽ = v_k`): the term is zero,
+        // and `C(q, 0)ᵀ 0` costs a Coriolis matrix to find it
+        if jump.iter().all(|x| x.is_zero()) {
+            return forces;
+        }
         forces + model.coriolis(q_e, &jump).tr_mul(&jump) * nalgebra::convert::<f64, T>(0.25)
     }
 
