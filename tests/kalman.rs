@@ -774,29 +774,58 @@ fn chi_square(dof: f64, z: f64) -> f64 {
 /// Runs where the filter's noise model is the truth: Example 1's mass with
 /// gravity switched off (the parameter `g = 0`) driven by white
 /// acceleration noise of density `q_a` on each coordinate, drawn exactly
-/// for one sampling interval (`[[τ³/3, τ²/2], [τ²/2, τ]] q_a²` per
-/// coordinate), away from the walls; positions sampled at 1 kHz with
-/// Gaussian noise `σ`. Over 100 independent runs (seeded), the sums of the
+/// for each sampling interval `τ_k` (`[[τ³/3, τ²/2], [τ²/2, τ]] q_a²` per
+/// coordinate), away from the walls; positions sampled with Gaussian
+/// noise `σ`. Over 100 independent runs (seeded), the sums of the
 /// normalised innovation squared (2 degrees of freedom) and of the
 /// normalised estimation error squared `x̃ᵀP⁻¹x̃` (4) at a fixed time are
 /// `χ²` with 200 and 400 degrees of freedom; both must lie inside their
-/// two-sided 99.9 % bounds at each of three times.
+/// two-sided 99.9 % bounds at each of three times (0.5, 1 and 2 s).
+///
+/// The filter takes samples at any rate, so the same holds at 1 kHz, at
+/// 100 Hz, at 10 kHz, and with intervals jittered over [0.5, 1.5] ms (a
+/// deterministic sequence, `0.5 + frac(k φ)` ms with the golden ratio
+/// `φ`).
 #[test]
 fn nis_and_nees_are_chi_square_where_the_noise_model_is_true() {
+    let golden = (5f64.sqrt() - 1.0) / 2.0;
+    let jittered = move |k: usize| 1e-3 * (0.5 + (k as f64 * golden).fract());
+    let schedules: [(&str, &dyn Fn(usize) -> f64); 4] = [
+        ("1 kHz", &|_| 1e-3),
+        ("100 Hz", &|_| 1e-2),
+        ("10 kHz", &|_| 1e-4),
+        ("jittered 0.5 to 1.5 ms", &jittered),
+    ];
+    for (label, interval) in schedules {
+        chi_square_where_the_noise_model_is_true(label, interval);
+    }
+}
+
+/// One sampling schedule of
+/// [`nis_and_nees_are_chi_square_where_the_noise_model_is_true`]: sample
+/// `k` (from 1) ends an interval of `interval(k)` seconds.
+fn chi_square_where_the_noise_model_is_true(label: &str, interval: &dyn Fn(usize) -> f64) {
     let mut model = Parabola::<f64>::new();
     *model
         .parameter_mut(Parabola::<f64>::parameter_index("g").unwrap())
         .unwrap() = 0.0;
     let u = SVector::zeros();
-    let (tau, q_a, sigma, runs): (f64, f64, f64, usize) = (1e-3, 0.05, 1e-4, 100);
-    let checks = [500usize, 1000, 2000];
+    let (q_a, sigma, runs): (f64, f64, usize) = (0.05, 1e-4, 100);
+    let times = [0.5, 1.0, 2.0];
+    // the sample each check takes: the first at or after its time
+    let mut checks = Vec::new();
+    let mut t = 0.0;
+    for k in 1.. {
+        t += interval(k);
+        if checks.len() < times.len() && t >= times[checks.len()] - 1e-9 {
+            checks.push(k);
+        }
+        if checks.len() == times.len() {
+            break;
+        }
+    }
     let mut nis = vec![0.0; checks.len()];
     let mut nees = vec![0.0; checks.len()];
-    // one coordinate's exact noise over τ: its Cholesky factor
-    let (a, b, c) = (tau.powi(3) / 3.0, tau * tau / 2.0, tau);
-    let l11 = a.sqrt();
-    let l21 = b / l11;
-    let l22 = (c - l21 * l21).sqrt();
     for run in 0..runs {
         let mut gauss = Gauss::new(1 + run as u64);
         let mut q = Vector2::new(0.0, 4.0);
@@ -815,18 +844,26 @@ fn nis_and_nees_are_chi_square_where_the_noise_model_is_true() {
             p0,
         )
         .unwrap();
+        let mut t = 0.0;
         for k in 1..=checks[checks.len() - 1] {
+            // one coordinate's exact noise over τ: its Cholesky factor
+            let tau = interval(k);
+            let (a, b, c) = (tau.powi(3) / 3.0, tau * tau / 2.0, tau);
+            let l11 = a.sqrt();
+            let l21 = b / l11;
+            let l22 = (c - l21 * l21).sqrt();
             for i in 0..2 {
                 let (z1, z2) = (gauss.normal(), gauss.normal());
                 q[i] += v[i] * tau + q_a * l11 * z1;
                 v[i] += q_a * (l21 * z1 + l22 * z2);
             }
+            t += tau;
             let y = q + Vector2::from_fn(|_, _| sigma * gauss.normal());
-            let e = filter.update(&model, k as f64 * tau, &y, &u).unwrap();
+            let e = filter.update(&model, t, &y, &u).unwrap();
             assert_eq!(
                 filter.report().contacts,
                 IndexSet::EMPTY,
-                "the walls are far"
+                "{label}: the walls are far"
             );
             if let Some(j) = checks.iter().position(|&c| c == k) {
                 nis[j] += filter.kalman_report().nis;
@@ -848,15 +885,17 @@ fn nis_and_nees_are_chi_square_where_the_noise_model_is_true() {
             chi_square(4.0 * runs as f64, z),
         );
         eprintln!(
-            "t = {} s: Σ NIS {:.1} in [{lo_nis:.1}, {hi_nis:.1}], Σ NEES {:.1} in [{lo_nees:.1}, {hi_nees:.1}]",
-            k as f64 * tau,
-            nis[j],
-            nees[j]
+            "{label}, t = {} s (sample {k}): Σ NIS {:.1} in [{lo_nis:.1}, {hi_nis:.1}], Σ NEES {:.1} in [{lo_nees:.1}, {hi_nees:.1}]",
+            times[j], nis[j], nees[j]
         );
-        assert!(nis[j] > lo_nis && nis[j] < hi_nis, "NIS at {k}: {}", nis[j]);
+        assert!(
+            nis[j] > lo_nis && nis[j] < hi_nis,
+            "{label}: NIS at {k}: {}",
+            nis[j]
+        );
         assert!(
             nees[j] > lo_nees && nees[j] < hi_nees,
-            "NEES at {k}: {}",
+            "{label}: NEES at {k}: {}",
             nees[j]
         );
     }
