@@ -931,27 +931,25 @@ fn the_filter_takes_samples_at_any_rate_on_every_shipped_model() {
             let data = reference::<_, N, K>(model, start, 1e-5, every, 6.0, &u);
             for sigma in [1e-6, 1e-4, 1e-3] {
                 let measured = measure(&data, sigma, 5);
+                let window = (2.0, 6.0);
                 let params = KalmanParams::new(50.0, sigma);
                 let mut filter =
                     SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros())
                         .unwrap();
-                let (estimates, restarts, refused) =
-                    observe_counting(&mut filter, model, (&data, &measured), &u, |_, _| {});
-                let sc = score(&data, &estimates, (2.0, 6.0));
+                let c = run_counting(&mut filter, model, (&data, &measured), &u, window);
                 let params = ObserverParams::new(10.0, 50.0).with_noise(sigma);
                 let mut observer =
                     ReducedOrder::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros())
                         .unwrap();
-                let (estimates, restarts_38, refused_38) =
-                    observe_counting(&mut observer, model, (&data, &measured), &u, |_, _| {});
-                let so = score(&data, &estimates, (2.0, 6.0));
+                let o = run_counting(&mut observer, model, (&data, &measured), &u, window);
+                let (sc, so) = (&c.scored, &o.scored);
                 let at = format!("{name}, {} Hz, σ = {sigma:e}", 100_000 / every);
                 eprintln!(
                     "{at}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}; (38) median {:.2e} max off the brackets {:.2e}",
                     sc.all.median, sc.all.p90, sc.clean.max, so.all.median, so.clean.max
                 );
                 assert_eq!(
-                    (restarts, refused, restarts_38, refused_38),
+                    (c.restarts, c.refused, o.restarts, o.refused),
                     (0, 0, 0, 0),
                     "{at}"
                 );
