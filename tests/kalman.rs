@@ -914,9 +914,9 @@ fn chi_square_where_the_noise_model_is_true(label: &str, interval: &dyn Fn(usize
 /// faults), and the filter's median is below (38)'s (measured: 1.6 to
 /// 1700 times). At `σ ≤ 1e-4` the filter's maximum off the samples that
 /// bracket a plant impact is within the issue's bound for (38), 0.1
-/// (measured at most 3.0e-2, the double pendulum at 1 kHz, σ = 1e-6; at 4
-/// kHz the file's start reaches 1.5e-2 and the billiard 1.0e-2, above the
-/// 1e-2 the issue asks of the filter at 1 kHz).
+/// (measured at most 3.0e-2, the double pendulum at 1 kHz, σ = 1e-6; the
+/// file's start at 4 kHz reaches 1.5e-2 and the billiard at 1 kHz 1.06e-2,
+/// above the 1e-2 the issue asks of the filter on its runs).
 #[test]
 fn the_filter_takes_samples_at_any_rate_on_every_shipped_model() {
     fn runs<M, const N: usize, const K: usize>(
