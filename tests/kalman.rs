@@ -771,6 +771,18 @@ fn chi_square(dof: f64, z: f64) -> f64 {
     dof * (1.0 - c + z * c.sqrt()).powi(3)
 }
 
+/// The Cholesky factor `(l11, l21, l22)` of one coordinate's white
+/// acceleration noise integrated exactly over `τ` (unit density):
+/// `[[τ³/3, τ²/2], [τ²/2, τ]]`. A draw `(z1, z2)` of two standard normals
+/// moves the position by `q_a l11 z1` and the velocity by `q_a (l21 z1 +
+/// l22 z2)`.
+fn white_noise_factor(tau: f64) -> (f64, f64, f64) {
+    let (a, b, c) = (tau.powi(3) / 3.0, tau * tau / 2.0, tau);
+    let l11 = a.sqrt();
+    let l21 = b / l11;
+    (l11, l21, (c - l21 * l21).sqrt())
+}
+
 /// Runs where the filter's noise model is the truth: Example 1's mass with
 /// gravity switched off (the parameter `g = 0`) driven by white
 /// acceleration noise of density `q_a` on each coordinate, drawn exactly
@@ -846,12 +858,8 @@ fn chi_square_where_the_noise_model_is_true(label: &str, interval: &dyn Fn(usize
         .unwrap();
         let mut t = 0.0;
         for k in 1..=checks[checks.len() - 1] {
-            // one coordinate's exact noise over τ: its Cholesky factor
             let tau = interval(k);
-            let (a, b, c) = (tau.powi(3) / 3.0, tau * tau / 2.0, tau);
-            let l11 = a.sqrt();
-            let l21 = b / l11;
-            let l22 = (c - l21 * l21).sqrt();
+            let (l11, l21, l22) = white_noise_factor(tau);
             for i in 0..2 {
                 let (z1, z2) = (gauss.normal(), gauss.normal());
                 q[i] += v[i] * tau + q_a * l11 * z1;
@@ -1023,10 +1031,7 @@ fn nis_and_nees_are_chi_square_through_impacts() {
     let (tau, sub, q_a, sigma, runs, e, g) = (1e-3, 100usize, 0.05, 1e-4, 100, 0.8, 9.81);
     let h = tau / sub as f64;
     let n = Vector2::new(-0.3, 1.0);
-    let (a, b, c) = (h.powi(3) / 3.0, h * h / 2.0, h);
-    let l11 = a.sqrt();
-    let l21 = b / l11;
-    let l22 = (c - l21 * l21).sqrt();
+    let (l11, l21, l22) = white_noise_factor(h);
     // [at the first sample after an impact, ten samples later]: (Σ NIS, Σ NEES, terms)
     let mut sums = [(0.0, 0.0, 0usize); 2];
     for run in 0..runs {

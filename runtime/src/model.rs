@@ -58,6 +58,13 @@ impl Structure {
         forces_input_free: false,
         jacobian_constant: false,
     };
+
+    /// Whether the free acceleration `a = −M⁻¹F` depends on neither `q`
+    /// nor `v`: `M` constant and `F` free of both (point masses under
+    /// constant forces). Its flow's Jacobian is then `(0, I; 0, 0)`.
+    pub(crate) const fn acceleration_state_free(&self) -> bool {
+        self.mass_constant && self.forces_configuration_free && self.forces_velocity_free
+    }
 }
 
 /// Static facts about a model: names, the model text and the size of its

@@ -323,11 +323,7 @@ impl<T: RealField + Copy, const N: usize> Cache<T, N> {
         M: Model<N, K, Scalar = T>,
     {
         let s = M::STRUCTURE;
-        let constant = s.mass_constant
-            && s.forces_velocity_free
-            && s.forces_configuration_free
-            && s.forces_time_free
-            && s.forces_input_free;
+        let constant = s.acceleration_state_free() && s.forces_time_free && s.forces_input_free;
         if !constant {
             return None;
         }

@@ -190,16 +190,6 @@ where
     }
 }
 
-/// Whether the model's free acceleration `a = −M⁻¹F` depends on neither
-/// `q` nor `v`, by its structure (`M` constant, `F` free of `q` and `v`:
-/// point masses under constant forces, as in Example 1, the three balls
-/// and the billiard): its flow's Jacobian is then `A = (0, I; 0, 0)`, and
-/// the transition over `h` exactly [`Blocks::ballistic`].
-const fn ballistic<M: Sensitivities<N, K>, const N: usize, const K: usize>() -> bool {
-    let s = M::STRUCTURE;
-    s.mass_constant && s.forces_configuration_free && s.forces_velocity_free
-}
-
 /// White acceleration noise of density `d` (a symmetric `N × N` matrix)
 /// integrated exactly over `h` for `q'' = w`:
 /// `[[h³/3, h²/2], [h²/2, h]] ⊗ d`.
@@ -420,9 +410,11 @@ where
                 held.insert(i);
             }
         }
-        let (phi, flown) = if held.is_empty() && ballistic::<M, N, K>() {
-            // Φ = (I, hI; 0, I) exactly, which the general path computes
-            // to the bit: no Jacobian, and the congruence written out
+        let (phi, flown) = if held.is_empty() && M::STRUCTURE.acceleration_state_free() {
+            // an acceleration free of q and v by the model's structure
+            // (Example 1, the three balls, the billiard): Φ = (I, hI; 0, I)
+            // exactly, which the general path computes to the bit; no
+            // Jacobian, and the congruence written out
             (
                 Blocks::ballistic(piece.h),
                 self.p.ballistic_congruence_covered(piece.h),

@@ -606,37 +606,30 @@ mod tests {
         assert!((full(&transition(&other, 0.37)) - taylor(&other, 0.37)).amax() <= 1e-14);
     }
 
-    /// Where the acceleration depends on neither `q` nor `v` (`A = (0, I;
-    /// 0, 0)`, as `flow_jacobian` gives it for such a model: `−M⁻¹ 0`),
-    /// the written-out transition and congruence give the general path's
-    /// bits, on covariances `L Lᵀ` of three coordinates with entries of
-    /// `L` drawn over six orders of magnitude, and over steps from a
-    /// microsecond to a second.
-    #[test]
-    fn the_ballistic_shortcut_is_the_general_flow_to_the_bit() {
-        use nalgebra::{Matrix3, Matrix6};
-        let a = Blocks::<f64, 3> {
-            qq: Matrix3::zeros(),
-            qv: Matrix3::identity(),
-            vq: -Matrix3::zeros(),
-            vv: -Matrix3::zeros(),
-        };
-        // a linear congruential generator: uniform in [0, 1)
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..200 {
-            let l = Matrix6::from_fn(|i, j| {
-                if j > i {
-                    0.0
-                } else {
-                    (2.0 * uniform() - 1.0) * 10f64.powf(-6.0 * uniform())
-                }
-            });
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config::with_cases(200))]
+
+        /// Where the acceleration depends on neither `q` nor `v` (`A = (0,
+        /// I; 0, 0)`, as `flow_jacobian` gives it for such a model: `−M⁻¹
+        /// 0`), the written-out transition and congruence give the general
+        /// path's bits, on covariances `L Lᵀ` of three coordinates with
+        /// entries of `L` over six orders of magnitude, and over steps from
+        /// a microsecond to a second.
+        #[test]
+        fn the_ballistic_shortcut_is_the_general_flow_to_the_bit(
+            entries in proptest::collection::vec((-1.0..1.0f64, -6.0..0.0f64), 21),
+            h_exponent in -6.0..0.0f64,
+        ) {
+            use nalgebra::{Matrix3, Matrix6};
+            let a = Blocks::<f64, 3> {
+                qq: Matrix3::zeros(),
+                qv: Matrix3::identity(),
+                vq: -Matrix3::zeros(),
+                vv: -Matrix3::zeros(),
+            };
+            // L lower-triangular, its 21 entries mantissa × 10^exponent
+            let mut lower = entries.iter().map(|&(m, e)| m * 10f64.powf(e));
+            let l = Matrix6::from_fn(|i, j| if j > i { 0.0 } else { lower.next().unwrap() });
             let full_p = l * l.transpose();
             let p = Blocks {
                 qq: full_p.fixed_view::<3, 3>(0, 0).into_owned(),
@@ -644,14 +637,10 @@ mod tests {
                 vq: full_p.fixed_view::<3, 3>(3, 0).into_owned(),
                 vv: full_p.fixed_view::<3, 3>(3, 3).into_owned(),
             };
-            for h in [1e-6, 1e-3, 0.37, 1.0] {
-                let phi = flow_transition(&a, h);
-                assert_eq!(phi, Blocks::ballistic(h));
-                assert_eq!(
-                    p.ballistic_congruence_covered(h),
-                    phi.congruence_covered(&p)
-                );
-            }
+            let h = 10f64.powf(h_exponent);
+            let phi = flow_transition(&a, h);
+            proptest::prop_assert_eq!(phi, Blocks::ballistic(h));
+            proptest::prop_assert_eq!(p.ballistic_congruence_covered(h), phi.congruence_covered(&p));
         }
     }
 }
