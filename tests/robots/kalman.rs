@@ -38,9 +38,13 @@ const VELOCITY_BOUND: f64 = 150.0;
 struct Run {
     filter: Scored,
     observer: Scored,
-    /// Restarts and refused samples, filter and (38).
+    /// Restarts and samples refused (by the screen of physically
+    /// impossible samples, `ObserverError::Outlier`), filter and (38).
     restarts: (usize, usize),
     refused: (usize, usize),
+    /// Samples the filter's innovation gate skipped (`KalmanReport::outlier`:
+    /// the update returns the prediction; not a refusal).
+    skipped: usize,
     /// The median over the window (without the samples that bracket a
     /// plant impact) of the filter's velocity NEES `eᵀ P_vv⁻¹ e`.
     nees_median: f64,
@@ -125,8 +129,10 @@ where
     let mut filter =
         SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros()).unwrap();
     let mut nees = Vec::new();
+    let mut skipped = 0;
     let (estimates, f_restarts, f_refused) =
         observe_counting(&mut filter, model, (data, &measured), &u, |j, f| {
+            skipped += usize::from(f.kalman_report().outlier);
             let s = &data.samples[j];
             if s.t >= WINDOW.0 && !bracket[j] {
                 let e = s.v - f.estimate().v;
@@ -154,6 +160,7 @@ where
         observer: score(data, &estimates, WINDOW),
         restarts: (f_restarts, o_restarts),
         refused: (f_refused, o_refused),
+        skipped,
         nees_median: nees[nees.len() / 2],
     }
 }
@@ -162,13 +169,14 @@ where
 /// restarts and refusals.
 fn print(name: &str, n: usize, r: &Run) {
     eprintln!(
-        "{name}, start {n}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}, velocity NEES median {:.2}, restarts {} refused {}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.2e}, restarts {} refused {}",
+        "{name}, start {n}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}, velocity NEES median {:.2}, restarts {} refused {} skipped by its gate {}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.2e}, restarts {} refused {}",
         r.filter.all.median,
         r.filter.all.p90,
         r.filter.clean.max,
         r.nees_median,
         r.restarts.0,
         r.refused.0,
+        r.skipped,
         r.observer.all.median,
         r.observer.all.p90,
         r.observer.clean.max,
@@ -177,9 +185,12 @@ fn print(name: &str, n: usize, r: &Run) {
     );
 }
 
-/// No restart of either estimator, at most one sample refused by each (the
-/// gate's false alarms: 3.2e-5 per sample, 0.06 per run), and the
-/// filter's median at least `factor` times below (38)'s.
+/// No restart of either estimator, at most one sample refused by each
+/// (refused: a sample farther than `C_v` lets the system move,
+/// `ObserverError::Outlier`), and the filter's median at least `factor`
+/// times below (38)'s. The samples the filter's innovation gate skips are
+/// printed, not asserted (measured: 3 on the Panda's start 1 with the
+/// defaults, none on any other run).
 fn assert_steady_and_ahead(at: &str, r: &Run, factor: f64) {
     assert_eq!(r.restarts, (0, 0), "{at}");
     assert!(
@@ -226,8 +237,9 @@ fn chi_square_median(n: usize) -> f64 {
 /// now the end is projected only onto the contacts it still lies on
 /// (module docs of `runtime/src/observer/kalman/propagate.rs`, `lifted`).
 ///
-/// Asserted on every run: no restart and at most one sample refused (the
-/// gate's false alarms: 3.2e-5 per sample, 0.06 per run); the issue's
+/// Asserted on every run: no restart and at most one sample refused (by
+/// the physical screen; the filter's innovation gate skipped none on
+/// these runs, printed); the issue's
 /// Example 1 targets, median at most 3e-5 rad/s and at most 1e-2 off the
 /// samples that bracket a plant impact; the median at least twenty times
 /// below (38)'s (the factor by which the hand-written Python
@@ -262,7 +274,9 @@ fn the_filter_follows_a_ur5_onto_and_off_a_table() {
 /// random starts.
 ///
 /// Asserted on every run: no restart and at most one sample refused by
-/// either estimator; the filter's median at least five times below (38)'s
+/// either estimator's physical screen (the filter's innovation gate
+/// skipped three samples on the Panda's start 1, none elsewhere;
+/// printed); the filter's median at least five times below (38)'s
 /// (measured: 8 to 45 times), and off the bracketing samples within the
 /// issue's 0.1 ((38), printed, up to 9.6e-2). The filter's largest, 2.0e-2
 /// and 2.2e-2 on Go1, are each at the first sample after a foot met the
