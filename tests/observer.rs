@@ -1278,6 +1278,18 @@ fn bad_input_is_refused_and_the_state_kept() {
         bad(ObserverParams::new(1.0, 1.0).with_noise(f64::NAN)),
         ObserverError::Data(DataError::InvalidParams { name: "noise", .. })
     ));
+    for step in [0.0, -1e-3, f64::NAN] {
+        assert!(matches!(
+            bad(ObserverParams {
+                max_step: step,
+                ..ObserverParams::new(1.0, 1.0)
+            }),
+            ObserverError::Data(DataError::InvalidParams {
+                name: "max_step",
+                ..
+            })
+        ));
+    }
     let gains = FullOrderGains {
         lambda: SMatrix::<f64, 3, 3>::from_diagonal(&Vector3::new(1.0, -1.0, 1.0)),
         l_rho1: SMatrix::identity(),

@@ -1055,6 +1055,20 @@ where
         })
     }
 
+    /// The length of the next Runge–Kutta step when `left` of the interval
+    /// remains: `left` itself up to one and a half times the longest step
+    /// ([`ObserverParams::max_step`]), else `left` split evenly into steps
+    /// of at most it (the step after then splits what is left again, to
+    /// the same length).
+    pub(crate) fn piece(&self, left: T) -> T {
+        let max = self.params.max_step;
+        let limit = max * nalgebra::convert(1.5);
+        if left <= limit {
+            return left;
+        }
+        left / (left / max).ceil()
+    }
+
     /// Classical fourth-order Runge–Kutta for `p' = w`, `w' = a(s, p, w)`
     /// over `[s0, s0 + h]` from `start`, with the persistent contacts
     /// `sliding` held; `stage` is the acceleration and the multipliers at

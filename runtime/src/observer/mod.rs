@@ -107,8 +107,12 @@
 //!    `p' = w`, `M(p) w' = −F̄(t_k + s, p, w)` (a second-order scheme would
 //!    leave a position error `τ³ |d³q/dt³|/6` per interval, which the
 //!    injection turns into a lag of `τ² |d³q/dt³|/6`: 8e-5 m/s where
-//!    Example 1 slides through the bottom of its parabola). Along each
-//!    piece, the cubic Hermite interpolant of `(p, w)` at its ends locates
+//!    Example 1 slides through the bottom of its parabola), one step per
+//!    piece between events, and steps of at most
+//!    [`ObserverParams::max_step`] (2 ms) in intervals longer than one
+//!    and a half times it, unless the acceleration is constant and one
+//!    step is exact. Along each
+//!    step, the cubic Hermite interpolant of `(p, w)` at its ends locates
 //!    the first constraint to close (Brent's method on `h_i(p(s))`, from
 //!    the root of the cubic Hermite interpolant of `h_i` itself, to
 //!    `max(1024 ε, ε^⅔) τ`); the piece is integrated again up to that root `s*`,
@@ -143,7 +147,8 @@
 //!    leaves `v̂_e ∈ V(q_{k+1})`, as (20) asks.
 //!
 //! Cost, with no constraint near: four evaluations of `(M, F̄)` and
-//! `L D Lᵀ` solves, three of `(h, J)`. An impact adds two Runge–Kutta legs
+//! `L D Lᵀ` solves, three of `(h, J)` (per step of `max_step`, in longer
+//! intervals). An impact adds two Runge–Kutta legs
 //! and a root search on `h`; a persistent contact, one small LCP per stage.
 //! Where the model's [`Structure`](crate::Structure) allows it, less: a
 //! constant `M` is factored once (a memo across updates), and with `F`

@@ -105,8 +105,14 @@ where
             ..Path::default()
         };
         let mut round = 0;
+        // whether the last piece of flight ended at the end of a step
+        // (`max_step`), not at an event: the next round continues it
+        let mut stepped = false;
         loop {
-            round += 1;
+            if !stepped {
+                round += 1;
+            }
+            stepped = false;
             let last_round = round >= max_rounds;
             // CLASSIFY at (s, p, w)
             let free = self.free(s, &p, &w, report)?;
@@ -158,11 +164,16 @@ where
                 path.touched = path.touched.union(c.approaching);
                 continue;
             }
-            // FLIGHT (and sliding) to the end of the interval
-            let rest = self.tau - s;
-            if rest <= T::zero() {
+            // FLIGHT (and sliding) to the end of the interval, one
+            // Runge–Kutta step of at most `max_step` at a time (one step
+            // where it is exact: a constant acceleration, nothing held)
+            let left = self.tau - s;
+            if left <= T::zero() {
                 return Ok((p, w));
             }
+            let exact = c.sliding.is_empty() && self.constant.is_some();
+            let rest = if exact { left } else { self.piece(left) };
+            let short = rest < left;
             // the held contacts' acceleration and force at the start, the
             // first Runge–Kutta stage of every piece from here
             let mut stage = self.constrained(&p, &w, c.sliding, &free, report)?;
@@ -231,7 +242,14 @@ where
                 impulse: &arc.impulse,
             })?;
             report.impulses += arc.impulse;
-            return Ok((arc.p, arc.w));
+            if !short {
+                return Ok((arc.p, arc.w));
+            }
+            // a step ended, not an event: the flight goes on from here,
+            // classified again, without counting as a round
+            (s, p, w) = (s + rest, arc.p, arc.w);
+            (resolved, path.touched, path.held) = (IndexSet::EMPTY, IndexSet::EMPTY, c.sliding);
+            stepped = true;
         }
     }
 }
