@@ -1037,7 +1037,7 @@ where
         first: &(SVector<T, N>, SVector<T, K>),
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Arc<T, N, K>, T> {
-        if !(sliding.is_empty() && self.constant.is_some()) {
+        if !self.one_step_exact(sliding) {
             return self.rk4(start, h, sliding, first, report);
         }
         // the three further stages' points, served by the memo
@@ -1055,12 +1055,23 @@ where
         })
     }
 
+    /// Whether one Runge–Kutta step over any length is exact: a constant
+    /// acceleration (the interval's `constant`) and no contact held.
+    fn one_step_exact(&self, sliding: IndexSet<K>) -> bool {
+        sliding.is_empty() && self.constant.is_some()
+    }
+
     /// The length of the next Runge–Kutta step when `left` of the interval
-    /// remains: `left` itself up to one and a half times the longest step
+    /// remains with the contacts `sliding` held: `left` itself where one
+    /// step is exact ([`one_step_exact`](Self::one_step_exact)) or up to
+    /// one and a half times the longest step
     /// ([`ObserverParams::max_step`]), else `left` split evenly into steps
     /// of at most it (the step after then splits what is left again, to
     /// the same length).
-    pub(crate) fn piece(&self, left: T) -> T {
+    pub(crate) fn piece(&self, left: T, sliding: IndexSet<K>) -> T {
+        if self.one_step_exact(sliding) {
+            return left;
+        }
         let max = self.params.max_step;
         let limit = max * nalgebra::convert(1.5);
         if left <= limit {

@@ -104,15 +104,10 @@ where
             bounced: self.last_impacted,
             ..Path::default()
         };
-        let mut round = 0;
-        // whether the last piece of flight ended at the end of a step
-        // (`max_step`), not at an event: the next round continues it
-        let mut stepped = false;
+        // rounds counted by the events that end them (an impact, a
+        // crossing); a step that ends at `max_step` continues its round
+        let mut round = 1;
         loop {
-            if !stepped {
-                round += 1;
-            }
-            stepped = false;
             let last_round = round >= max_rounds;
             // CLASSIFY at (s, p, w)
             let free = self.free(s, &p, &w, report)?;
@@ -162,6 +157,7 @@ where
                 w = w_plus;
                 resolved = resolved.union(c.approaching);
                 path.touched = path.touched.union(c.approaching);
+                round += 1;
                 continue;
             }
             // FLIGHT (and sliding) to the end of the interval, one
@@ -171,8 +167,7 @@ where
             if left <= T::zero() {
                 return Ok((p, w));
             }
-            let exact = c.sliding.is_empty() && self.constant.is_some();
-            let rest = if exact { left } else { self.piece(left) };
+            let rest = self.piece(left, c.sliding);
             let short = rest < left;
             // the held contacts' acceleration and force at the start, the
             // first Runge–Kutta stage of every piece from here
@@ -227,6 +222,7 @@ where
                     report.impulses += part.impulse;
                     (s, p, w) = (s + at, part.p, part.w);
                     (resolved, path.touched, path.held) = (IndexSet::EMPTY, set, c.sliding);
+                    round += 1;
                     continue;
                 }
             }
@@ -249,7 +245,6 @@ where
             // classified again, without counting as a round
             (s, p, w) = (s + rest, arc.p, arc.w);
             (resolved, path.touched, path.held) = (IndexSet::EMPTY, IndexSet::EMPTY, c.sliding);
-            stepped = true;
         }
     }
 }
