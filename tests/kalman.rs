@@ -1473,33 +1473,24 @@ where
     for (n, &start) in starts.iter().enumerate() {
         let data = reference(model, start, 1e-5, 100, 10.0, &u);
         let measured = measure(&data, sigma, 100 + n as u64);
-        let mut f = SaltationKalman::<f64, 2, K>::new(
-            KalmanParams::new(20.0, sigma),
-            0.0,
-            measured[0],
-            Vector2::zeros(),
-        )
-        .unwrap();
-        let mut skipped = 0;
-        let filter = run_counting(&mut f, model, (&data, &measured), &u, window, |_, f| {
-            skipped += usize::from(f.kalman_report().outlier);
-        });
+        // the filter with its defaults told `σ`, and the samples its gate skipped
+        let filter_on = |measured: &[Vector2<f64>], sigma: f64| {
+            let params = KalmanParams::new(20.0, sigma);
+            let mut f =
+                SaltationKalman::<f64, 2, K>::new(params, 0.0, measured[0], Vector2::zeros())
+                    .unwrap();
+            let mut skipped = 0;
+            let counted = run_counting(&mut f, model, (&data, measured), &u, window, |_, f| {
+                skipped += usize::from(f.kalman_report().outlier);
+            });
+            (counted, skipped)
+        };
+        let (filter, skipped) = filter_on(&measured, sigma);
+        let (exact, exact_skipped) = filter_on(&measure(&data, 0.0, 0), 0.0);
         let params = ObserverParams::new(10.0, 20.0).with_noise(sigma);
         let mut o =
             ReducedOrder::<f64, 2, K>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
         let observer = run_counting(&mut o, model, (&data, &measured), &u, window, |_, _| {});
-        let exact = measure(&data, 0.0, 0);
-        let mut e = SaltationKalman::<f64, 2, K>::new(
-            KalmanParams::new(20.0, 0.0),
-            0.0,
-            exact[0],
-            Vector2::zeros(),
-        )
-        .unwrap();
-        let mut exact_skipped = 0;
-        let exact = run_counting(&mut e, model, (&data, &exact), &u, window, |_, e| {
-            exact_skipped += usize::from(e.kalman_report().outlier);
-        });
         let (fs, os) = (&filter.scored, &observer.scored);
         eprintln!(
             "{name}, start {n} ({} plant impacts): filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}, {skipped} skipped by its gate; exact samples median {:.2e}, {exact_skipped} skipped; (38) median {:.2e} max off the brackets {:.3}",
