@@ -947,23 +947,8 @@ fn the_filter_takes_samples_at_any_rate_on_every_shipped_model() {
             for sigma in [1e-6, 1e-4, 1e-3] {
                 let measured = measure(&data, sigma, 5);
                 let window = (2.0, 6.0);
-                let params = KalmanParams::new(50.0, sigma);
-                let mut filter =
-                    SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros())
-                        .unwrap();
-                // the samples the filter's innovation gate skipped (the
-                // estimate held at the prediction; `Ok`, not refused)
-                let mut skipped = 0;
-                let c = run_counting(
-                    &mut filter,
-                    model,
-                    (&data, &measured),
-                    &u,
-                    window,
-                    |_, f: &SaltationKalman<f64, N, K>| {
-                        skipped += usize::from(f.kalman_report().outlier);
-                    },
-                );
+                let (c, skipped) =
+                    filter_counting(model, (&data, &measured), &u, (50.0, sigma), window);
                 let params = ObserverParams::new(10.0, 50.0).with_noise(sigma);
                 let mut observer =
                     ReducedOrder::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros())
@@ -1483,20 +1468,11 @@ where
     for (n, &start) in starts.iter().enumerate() {
         let data = reference(model, start, 1e-5, 100, 10.0, &u);
         let measured = measure(&data, sigma, 100 + n as u64);
-        // the filter with its defaults told `σ`, and the samples its gate skipped
-        let filter_on = |measured: &[Vector2<f64>], sigma: f64| {
-            let params = KalmanParams::new(20.0, sigma);
-            let mut f =
-                SaltationKalman::<f64, 2, K>::new(params, 0.0, measured[0], Vector2::zeros())
-                    .unwrap();
-            let mut skipped = 0;
-            let counted = run_counting(&mut f, model, (&data, measured), &u, window, |_, f| {
-                skipped += usize::from(f.kalman_report().outlier);
-            });
-            (counted, skipped)
-        };
-        let (filter, skipped) = filter_on(&measured, sigma);
-        let (exact, exact_skipped) = filter_on(&measure(&data, 0.0, 0), 0.0);
+        let (filter, skipped) =
+            filter_counting(model, (&data, &measured), &u, (20.0, sigma), window);
+        let exact = measure(&data, 0.0, 0);
+        let (exact, exact_skipped) =
+            filter_counting(model, (&data, &exact), &u, (20.0, 0.0), window);
         let params = ObserverParams::new(10.0, 20.0).with_noise(sigma);
         let mut o =
             ReducedOrder::<f64, 2, K>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
@@ -1572,6 +1548,30 @@ where
         restarts,
         refused,
     }
+}
+
+/// The filter with its defaults for the velocity bound `C_v` and the
+/// noise `σ`, from `v̂(0) = 0`, run over `measured` by
+/// [`run_counting`], and the samples its innovation gate skipped (the
+/// estimate held at the prediction; `Ok`, not refused).
+fn filter_counting<M, const N: usize, const K: usize>(
+    model: &M,
+    (data, measured): (&Reference<N>, &[SVector<f64, N>]),
+    u: &M::Input,
+    (c_v, sigma): (f64, f64),
+    window: (f64, f64),
+) -> (Counted, usize)
+where
+    M: Sensitivities<N, K, Scalar = f64>,
+{
+    let params = KalmanParams::new(c_v, sigma);
+    let mut filter =
+        SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros()).unwrap();
+    let mut skipped = 0;
+    let counted = run_counting(&mut filter, model, (data, measured), u, window, |_, f| {
+        skipped += usize::from(f.kalman_report().outlier);
+    });
+    (counted, skipped)
 }
 
 /// A bounce the filter can tell from sliding is followed, not held. The
@@ -1871,20 +1871,8 @@ fn a_sample_inside_a_held_contact_is_read_on_it() {
         }
     }
     let run = |measured: &[Vector2<f64>]| {
-        let params = KalmanParams::new(20.0, sigma);
-        let mut f =
-            SaltationKalman::<f64, 2, 1>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
-        let mut skipped = 0;
-        let counted = run_counting(
-            &mut f,
-            &model,
-            (&data, measured),
-            &u,
-            (2.0, 10.0),
-            |_, f| {
-                skipped += usize::from(f.kalman_report().outlier);
-            },
-        );
+        let (counted, skipped) =
+            filter_counting(&model, (&data, measured), &u, (20.0, sigma), (2.0, 10.0));
         (counted.scored, skipped)
     };
     let (plain, _) = run(&as_they_are);

@@ -936,7 +936,7 @@ where
         // READ a sample that lies deeper inside a held contact than the
         // gate allows on the contact (`read_on_held_contacts`)
         let read = read_on_held_contacts(
-            model,
+            &interval,
             q,
             propagation.held,
             (&self.params.measurement, self.params.gate),
@@ -1063,21 +1063,19 @@ where
 /// off (`+∞`) nothing is read differently. The update report's
 /// innovation stays the sample's own, `q − q_pred`.
 fn read_on_held_contacts<M, T, const N: usize, const K: usize>(
-    model: &M,
+    interval: &Interval<'_, M, T, N, K>,
     q: &SVector<T, N>,
     held: IndexSet<K>,
     (measurement, gate): (&SMatrix<T, N, N>, T),
 ) -> Result<SVector<T, N>, T>
 where
     T: RealField + Copy,
-    M: Sensitivities<N, K, Scalar = T>,
+    M: Model<N, K, Scalar = T>,
 {
     if held.is_empty() || !gate.is_finite() {
         return Ok(*q);
     }
-    let (h, jac) = model.contact(q);
-    validate::finite_model(&h, "h")?;
-    validate::finite_model(&jac, "J")?;
+    let (h, jac) = interval.contact(q)?;
     let deviations = gate.sqrt();
     let mut inside = IndexSet::<K>::EMPTY;
     for i in held.iter().filter(|&i| i < K) {
