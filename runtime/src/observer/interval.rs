@@ -16,6 +16,7 @@ use crate::validate::{self, factor_mass, finite_model as finite};
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 
+mod read;
 mod retime;
 mod traced;
 pub(crate) use retime::Impacts;

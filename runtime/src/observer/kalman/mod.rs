@@ -934,12 +934,11 @@ where
             ..KalmanReport::empty()
         };
         // READ a sample that lies deeper inside a held contact than the
-        // gate allows on the contact (`read_on_held_contacts`)
-        let read = read_on_held_contacts(
-            &interval,
+        // gate allows on the contact (`Interval::read_on_contacts`)
+        let read = interval.read_on_contacts(
             q,
             propagation.held,
-            (&self.params.measurement, self.params.gate),
+            (&self.params.measurement, self.params.gate.sqrt()),
         )?;
         // GATE the innovation (the report keeps the sample's own)
         let y = read - q_pred;
@@ -1040,68 +1039,6 @@ where
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
         Ok(Self::estimate(self))
     }
-}
-
-/// The sample `q` as the filter reads it where the prediction ends on held
-/// contacts (`held`): each held constraint whose gap the sample shows
-/// closed by more than `√gate` deviations of the measurement along its
-/// normal (`h_i(q) < −√gate √(J_i R J_iᵀ)`) is read on the contact, the
-/// sample moved onto `h_V = 0` for that set `V` by the least-squares step
-/// `−J_Vᵀ (J_V J_Vᵀ)⁻¹ h_V`. Any other sample is read as it is.
-///
-/// A rigid contact holds the prediction on its manifold, and the
-/// projection there leaves the covariance nothing across it but the
-/// interval's process noise. A sample inside it then fails the gate
-/// whatever it says along the contact, and keeps failing: the machine's
-/// compliance under a steady force, or a time-stepping plant's drift
-/// along a curved constraint (1.3e-9 m outside a circle, on exact
-/// samples), puts every sample there. Skipped twice, inflated, and
-/// again, the filter used one sample in three. The depth inside is what
-/// the rigid model has no state for; the rest of the sample, along the
-/// contact, is what it tracks. A sample outside a held contact is left as
-/// it is: that is how the samples show a contact opening. With the gate
-/// off (`+∞`) nothing is read differently. The update report's
-/// innovation stays the sample's own, `q − q_pred`.
-fn read_on_held_contacts<M, T, const N: usize, const K: usize>(
-    interval: &Interval<'_, M, T, N, K>,
-    q: &SVector<T, N>,
-    held: IndexSet<K>,
-    (measurement, gate): (&SMatrix<T, N, N>, T),
-) -> Result<SVector<T, N>, T>
-where
-    T: RealField + Copy,
-    M: Model<N, K, Scalar = T>,
-{
-    if held.is_empty() || !gate.is_finite() {
-        return Ok(*q);
-    }
-    let (h, jac) = interval.contact(q)?;
-    let deviations = gate.sqrt();
-    let mut inside = IndexSet::<K>::EMPTY;
-    for i in held.iter().filter(|&i| i < K) {
-        let row = jac.row(i);
-        let sigma = (row * measurement).dot(&row).max(T::zero()).sqrt();
-        if row.norm_squared() > T::zero() && h[i] < -deviations * sigma {
-            inside.insert(i);
-        }
-    }
-    if inside.is_empty() {
-        return Ok(*q);
-    }
-    // J_V J_Vᵀ on the rows and columns of `V`, the identity elsewhere
-    let mut gram = SMatrix::<T, K, K>::identity();
-    let mut gaps = SVector::<T, K>::zeros();
-    for i in inside.iter() {
-        gaps[i] = h[i];
-        for j in inside.iter() {
-            gram[(i, j)] = jac.row(i).dot(&jac.row(j));
-        }
-    }
-    let Some(chol) = nalgebra::linalg::Cholesky::new(gram) else {
-        return Ok(*q);
-    };
-    let x = chol.solve(&gaps);
-    Ok(q - jac.transpose() * x)
 }
 
 /// Releases the persistent contacts that the sample `q` shows open, when
