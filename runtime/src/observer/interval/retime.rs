@@ -50,33 +50,45 @@ struct Impact<T: RealField + Copy, const N: usize> {
     free: Free<T, N>,
 }
 
-/// What [`Interval::retime`] needs of the impacts of an interval: the
-/// restituted impacts, counted, and the last one, as a [`Tracer`] records
-/// them.
-pub(crate) struct Impacts<T: RealField + Copy, const N: usize> {
+/// What (38) under noise needs of the predicted motion of an interval, as
+/// a [`Tracer`] records it: for [`Interval::retime`], the restituted
+/// impacts, counted, and the last one; for
+/// [`Interval::read_on_contacts`], the contacts the predicted end lies on.
+pub(crate) struct Impacts<T: RealField + Copy, const N: usize, const K: usize> {
     /// The restituted impacts seen (one on several constraints at once
     /// counts twice: it is not timed again).
     count: u32,
     last: Option<Impact<T, N>>,
+    /// The constraints held along the last piece, pushing or resting, if
+    /// no impact law followed it (as the filter's propagation has them).
+    pub(crate) held: IndexSet<K>,
 }
 
-impl<T: RealField + Copy, const N: usize> Impacts<T, N> {
+impl<T: RealField + Copy, const N: usize, const K: usize> Impacts<T, N, K> {
     /// No impact seen yet.
     pub(crate) fn new() -> Self {
         Self {
             count: 0,
             last: None,
+            held: IndexSet::EMPTY,
         }
     }
 }
 
-impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for Impacts<T, N> {
-    #[inline(always)]
-    fn flight(&mut self, _: &Flight<'_, T, N, K>) -> Result<(), T> {
+impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for Impacts<T, N, K> {
+    fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
+        let mut held = IndexSet::EMPTY;
+        for i in piece.sliding.iter().filter(|&i| i < K) {
+            if piece.impulse[i] > T::zero() || piece.resting.contains(i) {
+                held.insert(i);
+            }
+        }
+        self.held = held;
         Ok(())
     }
 
     fn jump(&mut self, jump: &Jump<'_, T, N, K>) -> Result<(), T> {
+        self.held = IndexSet::EMPTY;
         let mut hit = IndexSet::<K>::EMPTY;
         for i in jump.elastic {
             if jump.lambda[i] > T::zero() && jump.restitution[i] > T::zero() {
@@ -117,7 +129,7 @@ where
     /// approach or the normal acceleration does not close the gap.
     pub(crate) fn retime(
         &self,
-        impacts: &Impacts<T, N>,
+        impacts: &Impacts<T, N, K>,
         d: &SVector<T, N>,
         (sigma, sigma_start): (T, T),
     ) -> Result<Option<SVector<T, N>>, T> {
