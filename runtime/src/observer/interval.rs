@@ -19,7 +19,7 @@ type Result<X, T> = core::result::Result<X, ObserverError<T>>;
 mod read;
 mod retime;
 mod traced;
-pub(crate) use retime::Impacts;
+pub(crate) use retime::Events;
 pub(crate) use traced::{Flight, Jump, Tracer};
 
 /// The radial saturation `sat(v) = v min(1, C_v/|v|)`: the projection onto

@@ -7,7 +7,7 @@ use crate::lcp::{IndexSet, Lcp};
 use crate::model::Model;
 
 use super::interval::{
-    Cache, Impacts, Interval, Memory, hold_to_bound, saturate, saturate_for, write_back,
+    Cache, Events, Interval, Memory, hold_to_bound, saturate, saturate_for, write_back,
 };
 use super::{
     Discretization, Estimate, Observer, ObserverError, ObserverParams, Outliers, Plan, Restart,
@@ -237,35 +237,36 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
         let result = match self.params.scheme {
             Discretization::ImpactAware => (|| {
                 // PREDICT from (q_k, v̂_k) (from q̄_k under noise), impacts
-                // inside the interval; under noise they are recorded, to be
-                // confirmed below (the exact-sample update keeps the plain
+                // inside the interval; under noise its events are recorded:
+                // the impacts, to be confirmed below, and the contacts held
+                // at its end (the exact-sample update keeps the plain
                 // prediction, and its cost)
-                let mut impacts = Impacts::new();
+                let mut events = Events::new();
                 let (p_end, w_end) = if self.params.noise > T::zero() {
-                    interval.predict_traced(&v0, report, &mut impacts)?
+                    interval.predict_traced(&v0, report, &mut events)?
                 } else {
                     interval.predict(&v0, report)?
                 };
-                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
-                // displacement, integrated exactly over τ
-                // (under noise the prediction starts from q̄_k, and the
-                // displacement it explains is `p(τ) − q̄_k`)
                 // READ under noise a sample deeper inside a contact held
                 // at the predicted end than the noise explains on the
                 // contact (`Interval::read_on_contacts`; four deviations,
                 // the smoothing's hold)
-                let q1 = if self.params.noise > T::zero() && !impacts.held.is_empty() {
+                let q1 = if self.params.noise > T::zero() && !events.held.is_empty() {
                     let variance = self.params.noise * self.params.noise;
                     let measurement = SMatrix::<T, N, N>::identity() * variance;
                     let deviations = nalgebra::convert(SMOOTHING_GATE);
                     interval.read_on_contacts(
                         &interval.q1,
-                        impacts.held,
+                        events.held,
                         (&measurement, deviations),
                     )?
                 } else {
                     interval.q1
                 };
+                // INJECT l_d ∫(v − v̂) = the measured minus the predicted
+                // displacement, integrated exactly over τ
+                // (under noise the prediction starts from q̄_k, and the
+                // displacement it explains is `p(τ) − q̄_k`)
                 let innovation = if interval.q0 == self.q {
                     q1 - p_end
                 } else {
@@ -277,7 +278,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
                 // again with the sample after it
                 let noise = (self.params.noise, interval.params.noise);
                 let v = if self.params.noise > T::zero() {
-                    match interval.retime(&impacts, &innovation, noise)? {
+                    match interval.retime(&events, &innovation, noise)? {
                         Some(dv) => v + dv,
                         None => v,
                     }

@@ -54,7 +54,7 @@ struct Impact<T: RealField + Copy, const N: usize> {
 /// a [`Tracer`] records it: for [`Interval::retime`], the restituted
 /// impacts, counted, and the last one; for
 /// [`Interval::read_on_contacts`], the contacts the predicted end lies on.
-pub(crate) struct Impacts<T: RealField + Copy, const N: usize, const K: usize> {
+pub(crate) struct Events<T: RealField + Copy, const N: usize, const K: usize> {
     /// The restituted impacts seen (one on several constraints at once
     /// counts twice: it is not timed again).
     count: u32,
@@ -64,7 +64,7 @@ pub(crate) struct Impacts<T: RealField + Copy, const N: usize, const K: usize> {
     pub(crate) held: IndexSet<K>,
 }
 
-impl<T: RealField + Copy, const N: usize, const K: usize> Impacts<T, N, K> {
+impl<T: RealField + Copy, const N: usize, const K: usize> Events<T, N, K> {
     /// No impact seen yet.
     pub(crate) fn new() -> Self {
         Self {
@@ -75,7 +75,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Impacts<T, N, K> {
     }
 }
 
-impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for Impacts<T, N, K> {
+impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for Events<T, N, K> {
     fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
         let mut held = IndexSet::EMPTY;
         for i in piece.sliding.iter().filter(|&i| i < K) {
@@ -122,14 +122,14 @@ where
     M: Model<N, K, Scalar = T>,
 {
     /// The change of the end velocity when the one restituted impact of
-    /// the interval (`impacts`) is timed again with the measured minus the
+    /// the interval (`events`) is timed again with the measured minus the
     /// predicted displacement `d` (see the module docs); `sigma` is the
     /// noise of a sample and `sigma_start` that of the start `q̄_k`. `None`
     /// without noise, without exactly one restituted impact, or where the
     /// approach or the normal acceleration does not close the gap.
     pub(crate) fn retime(
         &self,
-        impacts: &Impacts<T, N, K>,
+        events: &Events<T, N, K>,
         d: &SVector<T, N>,
         (sigma, sigma_start): (T, T),
     ) -> Result<Option<SVector<T, N>>, T> {
@@ -141,8 +141,8 @@ where
             e,
             row,
             free,
-        } = match impacts.last {
-            Some(last) if impacts.count == 1 && sigma > T::zero() => last,
+        } = match events.last {
+            Some(last) if events.count == 1 && sigma > T::zero() => last,
             _ => return Ok(None),
         };
         let approach = row.dot(&w.transpose());
