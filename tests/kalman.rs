@@ -1902,10 +1902,16 @@ fn a_sample_inside_a_held_contact_is_read_on_it() {
         let params = ObserverParams::new(10.0, 20.0).with_noise(sigma);
         let mut observer =
             ReducedOrder::<f64, 2, 1>::new(params, 0.0, measured[0], Vector2::zeros()).unwrap();
-        let (estimates, restarts, refused) =
-            observe_counting(&mut observer, &model, (&data, measured), &u, |_, _| {});
-        assert_eq!((restarts, refused), (0, 0));
-        score(&data, &estimates, (2.0, 10.0))
+        let counted = run_counting(
+            &mut observer,
+            &model,
+            (&data, measured),
+            &u,
+            (2.0, 10.0),
+            |_, _| {},
+        );
+        assert_eq!((counted.restarts, counted.refused), (0, 0));
+        counted.scored
     };
     let (plain, read) = (run_38(&as_they_are), run_38(&pressed));
     eprintln!(

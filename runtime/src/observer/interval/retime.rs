@@ -77,13 +77,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Events<T, N, K> {
 
 impl<T: RealField + Copy, const N: usize, const K: usize> Tracer<T, N, K> for Events<T, N, K> {
     fn flight(&mut self, piece: &Flight<'_, T, N, K>) -> Result<(), T> {
-        let mut held = IndexSet::EMPTY;
-        for i in piece.sliding.iter().filter(|&i| i < K) {
-            if piece.impulse[i] > T::zero() || piece.resting.contains(i) {
-                held.insert(i);
-            }
-        }
-        self.held = held;
+        self.held = piece.held();
         Ok(())
     }
 

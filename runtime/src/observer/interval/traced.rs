@@ -34,6 +34,23 @@ pub(crate) struct Flight<'a, T: RealField + Copy, const N: usize, const K: usize
     pub impulse: &'a SVector<T, K>,
 }
 
+impl<T: RealField + Copy, const N: usize, const K: usize> Flight<'_, T, N, K> {
+    /// The constraints held along the piece: those of `sliding` that
+    /// pushed (a positive impulse) or rest on their constraint with no
+    /// force (glued bodies in free flight). The contacts the piece's end
+    /// lies on, for the filter's projection and for reading a sample
+    /// ([`Interval::read_on_contacts`]).
+    pub(crate) fn held(&self) -> IndexSet<K> {
+        let mut held = IndexSet::EMPTY;
+        for i in self.sliding.iter().filter(|&i| i < K) {
+            if self.impulse[i] > T::zero() || self.resting.contains(i) {
+                held.insert(i);
+            }
+        }
+        held
+    }
+}
+
 /// One application of Newton's law at local time `s`, configuration `p`:
 /// the law took `w⁻` with the impulses `lambda` on the constraints of `set`
 /// (`ê` on `elastic`, `0` on the rest); `guard` holds the constraints whose

@@ -404,12 +404,7 @@ where
         // it with no force (glued bodies in free flight: without the
         // projection their relative velocity is only as well known as the
         // samples make it, and the estimate takes them apart)
-        let mut held = IndexSet::EMPTY;
-        for i in piece.sliding.iter().filter(|&i| i < K) {
-            if piece.impulse[i] > T::zero() || piece.resting.contains(i) {
-                held.insert(i);
-            }
-        }
+        let held = piece.held();
         let (phi, flown) = if held.is_empty() && M::STRUCTURE.acceleration_state_free() {
             // an acceleration free of q and v by the model's structure
             // (Example 1, the three balls, the billiard): Φ = (I, hI; 0, I)
