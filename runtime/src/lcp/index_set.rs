@@ -230,7 +230,8 @@ impl<const K: usize> IndexSet<K> {
         (0..K).all(|i| !self.0[i] || other.0[i])
     }
 
-    /// The indices in increasing order.
+    /// The indices in increasing order, each below `K` (so they index a
+    /// `K`-vector without a check of their own).
     #[inline]
     pub const fn iter(self) -> Iter<K> {
         Iter { set: self, next: 0 }

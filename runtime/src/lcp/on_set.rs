@@ -25,14 +25,14 @@ impl<T: RealField + Copy, const N: usize, const K: usize> OnSet<T, N, K> {
     /// [`OnSet`] for `jac`, `M`'s factor `mass` and `set`.
     pub(crate) fn new(jac: &SMatrix<T, K, N>, mass: &Ldlt<T, N>, set: IndexSet<K>) -> Self {
         let mut rows = SMatrix::<T, K, N>::zeros();
-        for i in set.iter().filter(|&i| i < K) {
+        for i in set {
             rows.set_row(i, &jac.row(i));
         }
         let minv_jt = mass.solve(&rows.transpose());
         let jmj = rows * minv_jt;
         let mut w = SMatrix::<T, K, K>::identity();
-        for a in set.iter().filter(|&i| i < K) {
-            for b in set.iter().filter(|&i| i < K) {
+        for a in set {
+            for b in set {
                 w[(a, b)] = jmj[(a, b)];
             }
         }

@@ -971,7 +971,7 @@ where
         let w = at.w;
         let mut set = IndexSet::<K>::EMPTY;
         let mut speed = SVector::<T, K>::zeros();
-        for i in sliding.iter().filter(|&i| i < K && lambda[i] > T::zero()) {
+        for i in sliding.iter().filter(|&i| lambda[i] > T::zero()) {
             let jw = jac.row(i).dot(&w.transpose());
             if jw > T::zero() {
                 set.insert(i);

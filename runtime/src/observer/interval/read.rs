@@ -58,7 +58,7 @@ where
         }
         let (h, jac) = self.contact(q)?;
         let mut inside = IndexSet::<K>::EMPTY;
-        for i in held.iter().filter(|&i| i < K) {
+        for i in held {
             let row = jac.row(i);
             let sigma = (row * measurement).dot(&row).max(T::zero()).sqrt();
             if row.norm_squared() > T::zero() && h[i] < -deviations * sigma {

@@ -42,7 +42,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Flight<'_, T, N, K> {
     /// ([`Interval::read_on_contacts`]).
     pub(crate) fn held(&self) -> IndexSet<K> {
         let mut held = IndexSet::EMPTY;
-        for i in self.sliding.iter().filter(|&i| i < K) {
+        for i in self.sliding {
             if self.impulse[i] > T::zero() || self.resting.contains(i) {
                 held.insert(i);
             }

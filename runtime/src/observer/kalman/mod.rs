@@ -1078,7 +1078,7 @@ where
     let mass = model.mass(q);
     validate::finite_model(&mass, "M")?;
     let chol = validate::factor_mass(&mass)?;
-    for i in held.iter().filter(|&i| i < K) {
+    for i in held {
         let row = jac.row(i);
         let sigma = (row * params.measurement * row.transpose())[0]
             .max(T::zero())

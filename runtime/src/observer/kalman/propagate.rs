@@ -234,7 +234,7 @@ where
             return SMatrix::zeros();
         }
         let mut push = SVector::<T, N>::zeros();
-        for i in held.iter().filter(|&i| i < K) {
+        for i in held {
             push += jac.row(i).transpose() * piece.impulse[i];
         }
         let accel = chol.solve(&push) / piece.h;
@@ -276,7 +276,7 @@ where
         // common piece, resting or sliding with no normal speed, needs no
         // forces and no law at its end
         let mut separating = IndexSet::<K>::EMPTY;
-        for i in held.iter().filter(|&i| i < K) {
+        for i in held {
             if jac.row(i).dot(&w1.transpose()) > T::zero() {
                 separating.insert(i);
             }
@@ -479,12 +479,12 @@ where
         // the restitutions of the elastic constraints, and the set that
         // took an impulse with theirs
         let mut e_set = SVector::<T, K>::zeros();
-        for i in jump.elastic.iter().filter(|&i| i < K) {
+        for i in jump.elastic {
             e_set[i] = jump.restitution[i];
         }
         let mut active = IndexSet::EMPTY;
         let mut e = SVector::<T, K>::zeros();
-        for i in jump.set.iter().filter(|&i| i < K) {
+        for i in jump.set {
             if jump.lambda[i] > T::zero() {
                 active.insert(i);
                 e[i] = e_set[i];
@@ -502,7 +502,6 @@ where
             .intersection(jump.elastic)
             .intersection(active)
             .iter()
-            .filter(|&i| i < K)
             .map(|i| {
                 let row = jac.row(i);
                 (i, row.dot(&jump.w_minus.transpose()) / row.norm())
@@ -526,7 +525,7 @@ where
             Law::Newton => newton(&e)?,
             Law::Moreau(least) => {
                 let mut uniform = SVector::<T, K>::zeros();
-                for i in active.iter().filter(|&i| i < K) {
+                for i in active {
                     uniform[i] = least;
                 }
                 newton(&uniform)?

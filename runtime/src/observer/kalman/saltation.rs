@@ -143,7 +143,7 @@ where
     finite(&rate_dq, "d(Jv)/dq")?;
     let c = rate_dq * v;
     let mut active = IndexSet::<K>::EMPTY;
-    for i in set.iter().filter(|&i| i < K) {
+    for i in set {
         active.insert(i);
     }
     // λ on the active rows; drop those that pull, once
@@ -419,7 +419,7 @@ where
     finite(&jac, "J")?;
     // rows off the active set are zero, and W gets 1 on their diagonal
     let mut e_a = SVector::<T, K>::zeros();
-    for i in active.iter().filter(|&i| i < K) {
+    for i in active {
         e_a[i] = e[i];
     }
     let OnSet {
@@ -456,7 +456,7 @@ where
     let dj_plus = model.jacobian_dq(q, &v_plus);
     let dj_minus = model.jacobian_dq(q, v_minus);
     let mut d_j = SMatrix::<T, K, N>::zeros();
-    for i in active.iter().filter(|&i| i < K) {
+    for i in active {
         d_j.set_row(i, &(dj_plus.row(i) + dj_minus.row(i) * e_a[i]));
     }
     finite(&d_j, "d(Jv)/dq")?;
@@ -534,7 +534,7 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
 ) -> Option<Projection<T, N>> {
     let mut d = SMatrix::<T, K, N>::zeros();
     let mut r_h = SVector::<T, K>::zeros();
-    for i in set.iter().filter(|&i| i < K) {
+    for i in set {
         d.set_row(i, &rate.row(i));
         r_h[i] = h[i];
     }
