@@ -3,6 +3,7 @@
 
 pub mod casadi;
 pub mod exact;
+pub mod phase;
 pub mod runs;
 
 use std::path::PathBuf;
