@@ -38,7 +38,7 @@ fn first_root(a: f64, b: f64, c: f64, on: bool) -> Option<f64> {
 }
 
 /// Free flight over `s` from `(q, v)`.
-fn flow(q: Vector2<f64>, v: Vector2<f64>, s: f64) -> (Vector2<f64>, Vector2<f64>) {
+pub fn flow(q: Vector2<f64>, v: Vector2<f64>, s: f64) -> (Vector2<f64>, Vector2<f64>) {
     (
         Vector2::new(q[0] + v[0] * s, q[1] + v[1] * s - 0.5 * G * s * s),
         Vector2::new(v[0], v[1] - G * s),

@@ -34,19 +34,13 @@ use moreau::{
     StepParams,
 };
 use moreau_models::Parabola;
+
+use super::exact::flow;
 use nalgebra::{Matrix2, SVector, Vector2};
 
 /// The plant's step and the samples' period (1 kHz: every 100th step).
 pub const TAU: f64 = 1e-5;
 const EVERY: usize = 100;
-const G: f64 = 9.81;
-
-/// The exact free flight under gravity from `(q, v)` over `r`.
-fn flight(q: Vector2<f64>, v: Vector2<f64>, r: f64) -> (Vector2<f64>, Vector2<f64>) {
-    let g = Vector2::new(0.0, -G);
-    (q + v * r + g * (0.5 * r * r), v + g * r)
-}
-
 /// A run of the plant with, for each sample, whether a step of the
 /// interval that ends at it gave any impulse (and the end of the first
 /// such step).
@@ -118,17 +112,17 @@ pub fn oracle(run: &StepRun, measured: &[Vector2<f64>], sigma: f64, phases: usiz
         let mut at = vec![Vec::with_capacity(phases); end - j + 1];
         for m in 0..phases {
             let u = m as f64 * TAU / phases as f64 - if back { TAU } else { 0.0 };
-            let (q, v) = flight(start.q, start.v, u);
+            let (q, v) = flow(start.q, start.v, u);
             let mut state = State::new(0.0, q, v);
             let to = run.samples[j].t - start.t - u;
             let steps = ((to + 1e-12) / TAU).floor() as usize;
             for _ in 0..steps {
                 stepper.step(&model, &mut state, &SVector::zeros()).unwrap();
             }
-            let first = flight(state.q, state.v, to - steps as f64 * TAU);
+            let first = flow(state.q, state.v, to - steps as f64 * TAU);
             for (k, row) in at.iter_mut().enumerate() {
                 let dt = run.samples[j + k].t - run.samples[j].t;
-                row.push(flight(first.0, first.1, dt));
+                row.push(flow(first.0, first.1, dt));
             }
         }
         let mut log_w = vec![0.0; phases];
