@@ -780,11 +780,8 @@ fn what_the_plants_step_alone_hides() {
         ratios.push(ratio);
         ratios_defaults.push(with_defaults.median / in_flight.median);
     }
-    let median = |r: &mut Vec<f64>| {
-        r.sort_by(f64::total_cmp);
-        r[r.len() / 2]
-    };
-    let (told_median, defaults_median) = (median(&mut ratios), median(&mut ratios_defaults));
+    let (told_median, defaults_median) =
+        (figures(&ratios).median, figures(&ratios_defaults).median);
     eprintln!(
         "restarted filter over the oracle in flight, median over the runs: told the step {told_median:.2}, defaults {defaults_median:.2}"
     );

@@ -41,9 +41,12 @@ use nalgebra::{Matrix2, SVector, Vector2};
 /// The plant's step and the samples' period (1 kHz: every 100th step).
 pub const TAU: f64 = 1e-5;
 const EVERY: usize = 100;
+
 /// A run of the plant with, for each sample, whether a step of the
 /// interval that ends at it gave any impulse (and the end of the first
-/// such step).
+/// such step). Not [`super::runs::reference`]: that records impacts
+/// approached faster than 1 cm/s, and the oracle's segments must end at
+/// every impulse, the slow bounces and resting contacts included.
 pub struct StepRun {
     pub samples: Vec<State<f64, 2>>,
     pub impulse: Vec<Option<f64>>,
