@@ -236,9 +236,28 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// rebounds about `t_c/2` after its first touch; a time-stepping plant
     /// that takes the impact into the step in which it happens (Moreau–Jean
     /// with a γ-prediction, as [`MoreauJean`](crate::MoreauJean)) resolves it on average half a
-    /// step late. [`tune_process_noise`] picks it from a recorded run,
-    /// with `σ_t`.
+    /// step late, and its velocity later still: for such samples set
+    /// [`KalmanParams::plant_step`] instead, which gives the velocity its
+    /// own mean delay. [`tune_process_noise`] picks `δ̄` from a recorded
+    /// run, with `σ_t`.
     pub impact_delay: T,
+    /// The step `τ_p` of the time-stepping plant the samples come from, in
+    /// seconds, or `0` (the default) for samples of a machine. A
+    /// Moreau–Jean plant at `θ = 1/2` that resolves an impact at the end
+    /// of the step whose prediction sees it (this crate's
+    /// [`MoreauJean`](crate::MoreauJean), as Siconos's) ends that step in
+    /// the state of an exact impact delayed by `τ_p/2 − s` in position and
+    /// by `τ_p/(1 + e) − s` in velocity, `s` where the gap's root falls
+    /// in the step (`e` the impact's restitution): the filter adds the
+    /// mean of each, `τ_p/2` and `τ_p/(1 + e)`, to
+    /// [`KalmanParams::impact_delay`], and the spread of `s` over a step,
+    /// `τ_p/√12`, to [`KalmanParams::impact_time_sigma`] in quadrature.
+    /// Telling it `τ_p/2` as a single delay instead leaves a mean error of
+    /// `τ_p (1/(1 + e) − 1/2)` in the velocity's delay, which inside an
+    /// accumulation of impacts drives an error the samples hardly see
+    /// (module `propagate`, "A time-stepping plant").
+    /// [`KalmanParams::with_plant_step`] sets it.
+    pub plant_step: T,
     /// Relative accuracy `ρ_c` of a persistent contact's force, as a
     /// density (units √s): along a piece of sliding or resting contact
     /// with contact acceleration `a_c = M⁻¹Jᵀλ`, white acceleration noise
@@ -368,6 +387,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             impact_noise: nalgebra::convert(1e-5),
             impact_time_sigma: nalgebra::convert(3e-6),
             impact_delay: T::zero(),
+            plant_step: T::zero(),
             contact_noise: nalgebra::convert(1e-6),
             band_sigmas: T::one(),
         }
@@ -386,6 +406,30 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     pub fn with_accel_noise(self, q_a: T) -> Self {
         Self {
             accel_noise: SVector::repeat(q_a),
+            ..self
+        }
+    }
+
+    /// The same settings for samples of a simulated rigid plant, a
+    /// Moreau–Jean time-stepping of step `tau` ([`KalmanParams::plant_step`]):
+    /// its impacts are instantaneous on its own time grid, so the grid's
+    /// phase is the only spread of their instants
+    /// ([`KalmanParams::impact_time_sigma`] `0`, the plant's step adding
+    /// `τ/√12`) and its step's mean delays the only mean
+    /// ([`KalmanParams::impact_delay`] `0`).
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanParams;
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant_step(1e-5);
+    /// assert_eq!((p.plant_step, p.impact_time_sigma, p.impact_delay), (1e-5, 0.0, 0.0));
+    /// ```
+    #[must_use]
+    pub fn with_plant_step(self, tau: T) -> Self {
+        Self {
+            plant_step: tau,
+            impact_time_sigma: T::zero(),
+            impact_delay: T::zero(),
             ..self
         }
     }
@@ -468,6 +512,9 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
         }
         if !self.impact_delay.is_finite() {
             return bad("impact_delay", self.impact_delay);
+        }
+        if !(self.plant_step >= T::zero() && self.plant_step.is_finite()) {
+            return bad("plant_step", self.plant_step);
         }
         Ok(())
     }
