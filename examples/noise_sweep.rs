@@ -11,10 +11,12 @@
 //! samples, the reduced-order observer (38), the full-order observer (36)
 //! and the saltation Kalman filter, on Example 1 from three initial states
 //! (the model file's accumulates at 4.456 s and then slides), the three
-//! balls and the double pendulum. The filter runs twice: with its default
-//! process noise (`KalmanParams::new`), and with the process noise picked
-//! once per system by `tune_process_noise` from a run with σ = 1e-4 and
-//! its own noise seed (its first 3 s); every σ adds its own noise to one
+//! balls and the double pendulum. The filter runs three times: with its
+//! default process noise (`KalmanParams::new`), with the process noise
+//! picked once per system by `tune_process_noise` from a run with σ = 1e-4
+//! and its own noise seed (its first 3 s), and with the defaults told that
+//! the samples come from the plant's Moreau–Jean step
+//! (`KalmanParams::with_plant_step`); every σ adds its own noise to one
 //! plant run.
 //!
 //! `cargo run --release --example noise_sweep`
@@ -27,13 +29,17 @@ use moreau::{
 };
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector, Vector2};
-use plotters::style::full_palette::{BLUE_700, GREEN_700, ORANGE_800, PURPLE_700, RED_600};
+use plotters::style::full_palette::{
+    BLUE_700, GREEN_700, GREY_700, ORANGE_800, PURPLE_700, RED_600,
+};
 use support::observe::{quantile, run, window};
 use support::plot::{Panel, Result, Series, announce, csv, figure};
 use support::reference::{Gaussian, Reference};
 use support::reference::{Sampling, sample};
 
 const T_END: f64 = 10.0;
+/// The plant's step: every run here is `MoreauJean` at 10 µs.
+const PLANT_STEP: f64 = 1e-5;
 
 fn main() -> Result<()> {
     let model = Parabola::<f64>::default();
@@ -58,7 +64,7 @@ fn main() -> Result<()> {
                 &model,
                 q0,
                 v0,
-                Sampling::new(1e-5, period, T_END).with_noise(sigma, 7 + i as u64),
+                Sampling::new(PLANT_STEP, period, T_END).with_noise(sigma, 7 + i as u64),
             )?;
             let params = ObserverParams::new(10.0, 20.0).with_noise(sigma);
             let mut observer =
@@ -141,12 +147,13 @@ fn main() -> Result<()> {
 }
 
 /// The estimators of the side-by-side tables, in their columns' order.
-const ESTIMATORS: [&str; 5] = [
+const ESTIMATORS: [&str; 6] = [
     "finite differences",
     "reduced (38)",
     "full (36)",
     "Kalman, defaults",
     "Kalman, tuned",
+    "Kalman, plant step",
 ];
 
 /// Median `|v − v̂|` over `[2, T_END]` s of each estimator on the same noisy
@@ -165,7 +172,7 @@ where
     let sigmas = [1e-6, 1e-5, 1e-4, 1e-3];
     let period = 1e-3;
     // one plant run; each σ adds its own seeded noise to the same positions
-    let exact = sample::<_, N, K, 0>(model, q0, v0, Sampling::new(1e-5, period, T_END))?;
+    let exact = sample::<_, N, K, 0>(model, q0, v0, Sampling::new(PLANT_STEP, period, T_END))?;
     let noisy = |sigma: f64, seed: u64| {
         let mut gauss = Gaussian::new(seed);
         let measured = exact
@@ -222,7 +229,9 @@ where
         row.extend(medians);
         rows.push(row);
     }
-    let colors = [RED_600, ORANGE_800, GREEN_700, PURPLE_700, BLUE_700];
+    let colors = [
+        RED_600, ORANGE_800, GREEN_700, PURPLE_700, BLUE_700, GREY_700,
+    ];
     let series = ESTIMATORS
         .iter()
         .enumerate()
@@ -234,7 +243,7 @@ where
     let stem = format!("noise_sweep_{stem}");
     let [png, svg] = figure(
         &stem,
-        &format!("{title}: median error under noise, four estimators"),
+        &format!("{title}: median error under noise, four estimators (the filter thrice)"),
         "log10 σ",
         &[Panel::new("median |v − v̂|", series).log()],
     )?;
@@ -245,20 +254,22 @@ where
         "full_36",
         "saltation_kalman_defaults",
         "saltation_kalman_tuned",
+        "saltation_kalman_plant_step",
     ];
     let data = csv(&stem, &header, rows)?;
     announce(&[&png, &svg, &data]);
     Ok(())
 }
 
-/// The four estimators on one sampled run; the median error of each.
+/// The estimators of [`ESTIMATORS`] on one sampled run; the median error
+/// of each.
 fn estimate_all<M, const N: usize, const K: usize>(
     model: &M,
     reference: &Reference<N>,
     sigma: f64,
     velocity_bound: f64,
     knobs: &KalmanParams<f64, N>,
-) -> Result<[f64; 5]>
+) -> Result<[f64; 6]>
 where
     M: Sensitivities<N, K, Scalar = f64, Input = SVector<f64, 0>>,
 {
@@ -280,9 +291,10 @@ where
     let gains = FullOrderGains::scalar(5.0, 25.0);
     let mut full = FullOrder::<f64, N, K>::new(params, gains, t[0], q[0], SVector::zeros())?;
     let full = run::<_, _, N, K, 0>(model, &mut full, reference)?.v;
-    // the filter with its default process noise, and with the tuned one,
-    // each told this run's σ
+    // the filter with its default process noise, with the tuned one, and
+    // told the plant's step, each told this run's σ
     let defaults = KalmanParams::new(velocity_bound, sigma);
+    let stepped = defaults.with_plant_step(PLANT_STEP);
     let tuned = KalmanParams {
         observer: ObserverParams {
             noise: sigma,
@@ -291,8 +303,8 @@ where
         measurement: SMatrix::identity() * (sigma * sigma),
         ..*knobs
     };
-    let mut kalman = [0.0; 2];
-    for (median, params) in kalman.iter_mut().zip([defaults, tuned]) {
+    let mut kalman = [0.0; 3];
+    for (median, params) in kalman.iter_mut().zip([defaults, tuned, stepped]) {
         let mut filter = SaltationKalman::<f64, N, K>::new(params, t[0], q[0], SVector::zeros())?;
         *median = score(&run::<_, _, N, K, 0>(model, &mut filter, reference)?.v);
     }
@@ -302,5 +314,6 @@ where
         score(&full),
         kalman[0],
         kalman[1],
+        kalman[2],
     ])
 }
