@@ -243,7 +243,7 @@ where
     let stem = format!("noise_sweep_{stem}");
     let [png, svg] = figure(
         &stem,
-        &format!("{title}: median error under noise, four estimators (the filter thrice)"),
+        &format!("{title}: median error under noise"),
         "log10 σ",
         &[Panel::new("median |v − v̂|", series).log()],
     )?;
