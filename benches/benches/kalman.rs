@@ -3,7 +3,9 @@
 //! backward finite difference of the samples (the estimators of the noise
 //! sweep's table), in one run, on Example 1 sampled at 1 kHz
 //! with σ = 1e-4: in free flight, with an impact inside the interval, and
-//! sliding. Each estimator is first run over the record up to the
+//! sliding. The filter runs with its defaults and told the plant's step
+//! (`KalmanParams::with_plant_step`, which carries the impacts' mean
+//! delays to the end of each interval). Each estimator is first run over the record up to the
 //! interval, so it starts from its own converged state; the copy of it
 //! that each timed update starts from is made outside the timed region.
 //!
@@ -65,6 +67,13 @@ fn updates(c: &mut Criterion) {
         let mut kalman =
             SaltationKalman::<f64, 2, 2>::new(kalman_params, 0.0, data[0].1, Vector2::zeros())
                 .unwrap();
+        let mut stepped = SaltationKalman::<f64, 2, 2>::new(
+            kalman_params.with_plant_step(1e-5),
+            0.0,
+            data[0].1,
+            Vector2::zeros(),
+        )
+        .unwrap();
         let observer_params = ObserverParams::new(10.0, 20.0).with_noise(1e-4);
         let mut reduced =
             ReducedOrder::<f64, 2, 2>::new(observer_params, 0.0, data[0].1, Vector2::zeros())
@@ -75,6 +84,7 @@ fn updates(c: &mut Criterion) {
                 .unwrap();
         for (t, q, _) in &data[1..k] {
             kalman.update(&model, *t, q, &u).unwrap();
+            stepped.update(&model, *t, q, &u).unwrap();
             reduced.update(&model, *t, q, &u).unwrap();
             full.update(&model, *t, q, &u).unwrap();
         }
@@ -105,6 +115,16 @@ fn updates(c: &mut Criterion) {
                 BatchSize::SmallInput,
             )
         });
+        group.bench_function(
+            format!("saltation Kalman told the plant's step, {label}"),
+            |b| {
+                b.iter_batched_ref(
+                    || stepped,
+                    |f| f.update(&model, black_box(t), &q, &u).unwrap(),
+                    BatchSize::SmallInput,
+                )
+            },
+        );
         group.bench_function(format!("reduced (38), {label}"), |b| {
             b.iter_batched_ref(
                 || reduced,
