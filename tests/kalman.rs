@@ -650,10 +650,10 @@ fn the_plants_impacts_come_half_a_step_late() {
 /// velocity error left once the position's delay is taken out is 3e-6 to
 /// 1.6e-5 m/s, against 8e-6 to 4.5e-4 m/s of error. So the delay, not
 /// some other error of the plant's law, is what the filter's
-/// `impact_time_sigma` and `impact_delay` describe, and the two means
-/// (`τ/2`, `τ/(1 + e)`) what [`KalmanParams::plant_step`] adds; what a
-/// run's samples cannot tell is each impact's own delay, spread over a
-/// step.
+/// `impact_time_sigma` and `impact_delay` describe, with the velocity's
+/// constant on top, which [`KalmanParams::plant`] takes from the plant's
+/// own step at each impact; what a run's samples cannot tell is each
+/// impact's own delay, spread over a step.
 #[test]
 fn the_plants_impacts_are_exact_impacts_delayed() {
     let model = Parabola::<f64>::new();
@@ -729,13 +729,13 @@ fn the_plants_impacts_are_exact_impacts_delayed() {
 ///   impact adds the rest;
 /// - the filter, restarted as the oracle is from the exact state before
 ///   each impact and told the plant's step
-///   ([`KalmanParams::with_plant_step`]: the step's mean delays and
-///   its spread `τ/√12`, the moments of a uniform phase), is a Gaussian
+///   ([`KalmanParams::with_plant_step`]: the plant's own step at each
+///   impact and the spread `τ/√12` of a uniform phase), is a Gaussian
 ///   stand-in for that posterior: its median error in flight is within
 ///   2.5 times the oracle's in the median over the runs and within 5
-///   times on each (measured 0.95 to 3.41, median 1.86). Told `τ/2` as one
+///   times on each (measured 0.97 to 3.33, median 1.81). Told `τ/2` as one
 ///   delay of position and velocity alike it is the same here (median
-///   1.81; printed): the velocity's own mean delay matters inside
+///   1.81; printed): the velocity's own delay matters inside
 ///   accumulations, which a restart at every impact does not let build up
 ///   (`a_single_delay_drifts_inside_an_accumulation`). With the defaults
 ///   (no mean delay) it is about one and a half times further (median
@@ -874,12 +874,12 @@ fn a_mean_impact_delay_moves_the_prediction_as_a_delayed_impact_does() {
     }
 }
 
-/// Why [`KalmanParams::plant_step`] delays the velocity after an impact
-/// by its own mean, `τ/(1 + e)`, and not by the position's `τ/2`: the
-/// plant's impacts are exact impacts delayed by `τ/2 − s` in position and
-/// by `τ/(1 + e) − s` in velocity (`the_plants_impacts_are_exact_impacts_delayed`),
-/// and inside an accumulation of impacts a mean error in the velocity's
-/// delay builds up bounce by bounce into an error the samples hardly see.
+/// Why [`KalmanParams::plant`] takes the plant's own step at each impact
+/// instead of delaying it by `τ/2`: the plant's impacts are exact impacts
+/// delayed by `τ/2 − s` in position but by `τ/(1 + e) − s` in velocity
+/// (`the_plants_impacts_are_exact_impacts_delayed`), and inside an
+/// accumulation of impacts a mean error in the velocity's delay builds up
+/// bounce by bounce into an error the samples hardly see.
 /// The model file's start, the 22 bounces from 4.36 s to 4.44 s
 /// (approached at 1.0 down to 0.06 m/s, 2 to 10 ms apart, while the mass
 /// slides along the curved floor), the normal velocity's error
@@ -892,13 +892,14 @@ fn a_mean_impact_delay_moves_the_prediction_as_a_delayed_impact_does() {
 ///   behind by a little more at each bounce: its bounces come earlier and
 ///   earlier, while its positions stay within a few micrometres of the
 ///   plant's;
-/// - told the plant's step, which delays the velocity by `τ/(1 + e)`, it
-///   holds, as the defaults (no mean delay at all) do.
+/// - told the plant (`with_plant_step`), whose own step at each impact
+///   carries the velocity's later delay, it holds, as the defaults (no
+///   mean delay at all) do.
 ///
 /// Asserted: told the plant's step, the largest such error is at most a
 /// quarter of the one-delay filter's and at most 1e-2, on both sample
-/// sets. Measured: exact samples 3.8e-3 against 2.0e-2 (defaults 3.8e-3;
-/// means over the window 2.2e-3 against 5.7e-3), noisy samples 3.0e-3
+/// sets. Measured: exact samples 3.7e-3 against 2.0e-2 (defaults 3.8e-3;
+/// means over the window 2.1e-3 against 5.7e-3), noisy samples 3.2e-3
 /// against 1.75e-2 (defaults 2.8e-3). In a scratch run on the exact
 /// samples, the one-delay filter's `∇h·(v̂ − v)` at 4.434 s moved
 /// linearly with the delay, by 6.5e-3 to 6.9e-3 m/s per microsecond
@@ -1390,8 +1391,8 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
 /// the filter with its default process noise, with the four knobs
 /// picked once by the likelihood helper from another noisy run (the model
 /// file's start, its own noise seed), and told the plant's step
-/// ([`KalmanParams::with_plant_step`]: the mean delays and the spread of a
-/// Moreau–Jean step of 10 µs, nothing picked from a run).
+/// ([`KalmanParams::with_plant_step`]: the plant's own Moreau–Jean step
+/// of 10 µs at each impact and its spread, nothing picked from a run).
 ///
 /// Asserted: with exact samples the median is at most 1e-8 (the issue's
 /// figure); with `σ = 1e-4` the median is at most 1e-4 and the 90th
@@ -1408,7 +1409,7 @@ fn tuned_example_1(sigma: f64) -> KalmanParams<f64, 2> {
 /// starts of four (the plant places each impact somewhere in its 10 µs
 /// step; see the README). Told the plant's step, the filter meets all
 /// three of the targets on all four starts, asserted (measured:
-/// medians 1.33e-5 to 2.27e-5, 90th percentiles 7.9e-5 to 1.63e-4,
+/// medians 1.30e-5 to 2.29e-5, 90th percentiles 8.0e-5 to 1.64e-4,
 /// maxima off the brackets 3.0e-4 to 5.7e-3).
 #[test]
 fn example_1_figures_beside_the_reduced_order_observer() {
@@ -1505,7 +1506,7 @@ fn example_1_figures_beside_the_reduced_order_observer() {
 /// 90th percentile ≤ 2e-4 together hold on 15 of the 48 (median 1.1e-5
 /// to 7.3e-5, 90th percentile 8.5e-5 to 3.4e-4; 13 before held contacts
 /// stopped doing work on a separating estimate); told the plant's step,
-/// on 22 of the 48. A throw-away run of the
+/// on 23 of the 48. A throw-away run of the
 /// same 48 against the plant at `τ = 1e-6`, with `σ_t` set to that
 /// plant's `τ/√12 = 0.29 µs`, met both on 40 of 48 (median up to 4.0e-5,
 /// 90th percentile up to 2.3e-4 on the others): most of the gap is the
@@ -2964,10 +2965,7 @@ fn bad_input_is_refused_and_the_state_kept() {
     for tau in [-1e-5, f64::INFINITY] {
         assert!(matches!(
             bad(base.with_plant_step(tau)),
-            ObserverError::Data(DataError::InvalidParams {
-                name: "plant_step",
-                ..
-            })
+            ObserverError::Data(DataError::InvalidParams { name: "plant", .. })
         ));
     }
     assert!(matches!(

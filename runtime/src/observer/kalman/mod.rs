@@ -155,6 +155,7 @@ use nalgebra::{RealField, SMatrix, SVector};
 
 use crate::lcp::{IndexSet, Lcp};
 use crate::model::{Model, Sensitivities};
+use crate::stepper::StepParams;
 
 use super::interval::{Cache, Interval, Memory, moved_past_bound, saturate, write_back};
 use super::reduced_order::restart_velocity;
@@ -236,28 +237,32 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// rebounds about `t_c/2` after its first touch; a time-stepping plant
     /// that takes the impact into the step in which it happens (Moreau–Jean
     /// with a γ-prediction, as [`MoreauJean`](crate::MoreauJean)) resolves it on average half a
-    /// step late, and its velocity later still: for such samples set
-    /// [`KalmanParams::plant_step`] instead, which gives the velocity its
-    /// own mean delay. [`tune_process_noise`] picks `δ̄` from a recorded
+    /// step late, and with its law's own error on top: for such samples
+    /// set [`KalmanParams::plant`] instead. [`tune_process_noise`] picks `δ̄` from a recorded
     /// run, with `σ_t`.
     pub impact_delay: T,
-    /// The step `τ_p` of the time-stepping plant the samples come from, in
-    /// seconds, or `0` (the default) for samples of a machine. A
-    /// Moreau–Jean plant at `θ = 1/2` that resolves an impact at the end
-    /// of the step whose prediction sees it (this crate's
-    /// [`MoreauJean`](crate::MoreauJean), as Siconos's) ends that step in
-    /// the state of an exact impact delayed by `τ_p/2 − s` in position and
-    /// by `τ_p/(1 + e) − s` in velocity, `s` where the gap's root falls
-    /// in the step (`e` the impact's restitution): the filter adds the
-    /// mean of each, `τ_p/2` and `τ_p/(1 + e)`, to
-    /// [`KalmanParams::impact_delay`], and the spread of `s` over a step,
-    /// `τ_p/√12`, to [`KalmanParams::impact_time_sigma`] in quadrature.
-    /// Telling it `τ_p/2` as a single delay instead leaves a mean error of
-    /// `τ_p (1/(1 + e) − 1/2)` in the velocity's delay, which inside an
-    /// accumulation of impacts drives an error the samples hardly see
-    /// (module `propagate`, "A time-stepping plant").
-    /// [`KalmanParams::with_plant_step`] sets it.
-    pub plant_step: T,
+    /// The time-stepping plant the samples come from, or `None` (the
+    /// default) for samples of a machine. A plant that steps across an
+    /// impact (Moreau–Jean: this crate's [`MoreauJean`](crate::MoreauJean), as Siconos's) ends
+    /// that step in a state an exact impact does not reach: late by part
+    /// of a step, and with its own law's error on top (for a Moreau–Jean
+    /// step at `θ = 1/2` on Example 1 the velocity comes `τ (1/(1 + e) −
+    /// 1/2)` later than the position; where forces depend on the velocity,
+    /// as a robot's do, more than that). So at each impact a gap's root
+    /// timed, the filter takes one step of this plant from the impact, the
+    /// gap closing at the step's start (the middle of where it closes for
+    /// the plant, over a step, to first order), and moves its prediction
+    /// by that step's end against the exact impact's at the same time;
+    /// the spread of where the gap closes in a step, `τ/√12`, adds to
+    /// [`KalmanParams::impact_time_sigma`] in quadrature. Where that one
+    /// step fails, the prediction moves as an impact half a step late
+    /// does. Telling the filter `τ/2` as one delay of position and
+    /// velocity instead leaves the law's error, which inside an
+    /// accumulation of impacts builds up into an error the samples hardly
+    /// see (module `propagate`, "A time-stepping plant").
+    /// [`KalmanParams::with_plant_step`] and [`KalmanParams::with_plant`]
+    /// set it.
+    pub plant: Option<StepParams<T>>,
     /// Relative accuracy `ρ_c` of a persistent contact's force, as a
     /// density (units √s): along a piece of sliding or resting contact
     /// with contact acceleration `a_c = M⁻¹Jᵀλ`, white acceleration noise
@@ -387,7 +392,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             impact_noise: nalgebra::convert(1e-5),
             impact_time_sigma: nalgebra::convert(3e-6),
             impact_delay: T::zero(),
-            plant_step: T::zero(),
+            plant: None,
             contact_noise: nalgebra::convert(1e-6),
             band_sigmas: T::one(),
         }
@@ -410,24 +415,41 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
         }
     }
 
-    /// The same settings for samples of a simulated rigid plant, a
-    /// Moreau–Jean time-stepping of step `tau` ([`KalmanParams::plant_step`]):
-    /// its impacts are instantaneous on its own time grid, so the grid's
-    /// phase is the only spread of their instants
-    /// ([`KalmanParams::impact_time_sigma`] `0`, the plant's step adding
-    /// `τ/√12`) and its step's mean delays the only mean
+    /// The same settings for samples of a simulated rigid plant,
+    /// [`MoreauJean`](crate::MoreauJean) at the step `tau` with its default settings
+    /// ([`KalmanParams::plant`]): its impacts are instantaneous on its own
+    /// time grid, so the grid's phase is the only spread of their instants
+    /// ([`KalmanParams::impact_time_sigma`] `0`, the plant adding
+    /// `τ/√12`) and its own step the only offset
     /// ([`KalmanParams::impact_delay`] `0`).
     ///
     /// ```
     /// use moreau_runtime::KalmanParams;
     ///
     /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant_step(1e-5);
-    /// assert_eq!((p.plant_step, p.impact_time_sigma, p.impact_delay), (1e-5, 0.0, 0.0));
+    /// assert_eq!(p.plant.map(|plant| plant.tau), Some(1e-5));
+    /// assert_eq!((p.impact_time_sigma, p.impact_delay), (0.0, 0.0));
     /// ```
     #[must_use]
     pub fn with_plant_step(self, tau: T) -> Self {
+        self.with_plant(StepParams::new(tau))
+    }
+
+    /// [`KalmanParams::with_plant_step`] for a plant with other settings
+    /// than the defaults (Siconos's law, for one:
+    /// [`ApproachVelocity::Start`](crate::ApproachVelocity::Start)).
+    ///
+    /// ```
+    /// use moreau_runtime::{ApproachVelocity, KalmanParams, StepParams};
+    ///
+    /// let siconos = StepParams::new(1e-5).with_approach_velocity(ApproachVelocity::Start);
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant(siconos);
+    /// assert_eq!(p.plant, Some(siconos));
+    /// ```
+    #[must_use]
+    pub fn with_plant(self, plant: StepParams<T>) -> Self {
         Self {
-            plant_step: tau,
+            plant: Some(plant),
             impact_time_sigma: T::zero(),
             impact_delay: T::zero(),
             ..self
@@ -513,8 +535,10 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
         if !self.impact_delay.is_finite() {
             return bad("impact_delay", self.impact_delay);
         }
-        if !(self.plant_step >= T::zero() && self.plant_step.is_finite()) {
-            return bad("plant_step", self.plant_step);
+        if let Some(plant) = self.plant {
+            if crate::MoreauJean::new(plant).is_err() {
+                return bad("plant", plant.tau);
+            }
         }
         Ok(())
     }
