@@ -4,8 +4,8 @@
 //! sweep's table), in one run, on Example 1 sampled at 1 kHz
 //! with σ = 1e-4: in free flight, with an impact inside the interval, and
 //! sliding. The filter runs with its defaults and told the plant's step
-//! (`KalmanParams::with_plant_step`, which carries the impacts' mean
-//! delays to the end of each interval). Each estimator is first run over the record up to the
+//! (`KalmanParams::with_plant_step`, which takes one step of the plant
+//! at each impact). Each estimator is first run over the record up to the
 //! interval, so it starts from its own converged state; the copy of it
 //! that each timed update starts from is made outside the timed region.
 //!
