@@ -1550,25 +1550,24 @@ fn example_1_random_starts_beside_the_reduced_order_observer() {
                 met_step + usize::from(issue(&sp)),
                 met_38 + usize::from(so.clean.max <= 0.1),
             );
+            let line = |f: &Scored| {
+                format!(
+                    "median {:.2e} p90 {:.2e} max off the brackets {:.2e}{}",
+                    f.all.median,
+                    f.all.p90,
+                    f.clean.max,
+                    if issue(f) {
+                        ""
+                    } else {
+                        " (misses 3e-5 / 2e-4)"
+                    }
+                )
+            };
             eprintln!(
-                "seed {seed}, start {n} {start:?}: filter median {:.2e} p90 {:.2e} max off the brackets {:.2e}{}, exact samples median {:.2e}; told the plant's step median {:.2e} p90 {:.2e} max off the brackets {:.2e}{}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.3}",
-                sc.all.median,
-                sc.all.p90,
-                sc.clean.max,
-                if issue(&sc) {
-                    ""
-                } else {
-                    " (misses 3e-5 / 2e-4)"
-                },
+                "seed {seed}, start {n} {start:?}: filter {}, exact samples median {:.2e}; told the plant's step {}; (38) median {:.2e} p90 {:.2e} max off the brackets {:.3}",
+                line(&sc),
                 se.all.median,
-                sp.all.median,
-                sp.all.p90,
-                sp.clean.max,
-                if issue(&sp) {
-                    ""
-                } else {
-                    " (misses 3e-5 / 2e-4)"
-                },
+                line(&sp),
                 so.all.median,
                 so.all.p90,
                 so.clean.max,

@@ -238,22 +238,23 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// that takes the impact into the step in which it happens (Moreau–Jean
     /// with a γ-prediction, as [`MoreauJean`](crate::MoreauJean)) resolves it on average half a
     /// step late, and with its law's own error on top: for such samples
-    /// set [`KalmanParams::plant`] instead. [`tune_process_noise`] picks `δ̄` from a recorded
-    /// run, with `σ_t`.
+    /// set [`KalmanParams::plant`] instead. [`tune_process_noise`] picks
+    /// `δ̄` from a recorded run, with `σ_t`.
     pub impact_delay: T,
     /// The time-stepping plant the samples come from, or `None` (the
     /// default) for samples of a machine. A plant that steps across an
-    /// impact (Moreau–Jean: this crate's [`MoreauJean`](crate::MoreauJean), as Siconos's) ends
-    /// that step in a state an exact impact does not reach: late by part
-    /// of a step, and with its own law's error on top (for a Moreau–Jean
-    /// step at `θ = 1/2` on Example 1 the velocity comes `τ (1/(1 + e) −
-    /// 1/2)` later than the position; where forces depend on the velocity,
-    /// as a robot's do, more than that). So at each impact a gap's root
-    /// timed, the filter takes one step of this plant from the impact, the
-    /// gap closing at the step's start (the middle of where it closes for
-    /// the plant, over a step, to first order), and moves its prediction
-    /// by that step's end against the exact impact's at the same time;
-    /// the spread of where the gap closes in a step, `τ/√12`, adds to
+    /// impact (Moreau–Jean: this crate's [`MoreauJean`](crate::MoreauJean),
+    /// as Siconos's) ends that step in a state an exact impact does not
+    /// reach: late by part of a step, and with its own law's error on top
+    /// (for a Moreau–Jean step at `θ = 1/2` on Example 1 the normal
+    /// velocity comes `τ (1/(1 + e) − 1/2)` later than the position; where
+    /// forces depend on the velocity, as a robot's do, the error has
+    /// another shape). So at each impact a gap's root timed, the filter
+    /// takes one step of this plant from the impact, the gap closing at
+    /// the step's start (the middle of where it closes for the plant, over
+    /// a step, to first order), and moves its prediction by that step's
+    /// end against the exact impact's at the same time; the spread of
+    /// where the gap closes in a step, `τ/√12`, adds to
     /// [`KalmanParams::impact_time_sigma`] in quadrature. Where that one
     /// step fails, the prediction moves as an impact half a step late
     /// does. Telling the filter `τ/2` as one delay of position and
