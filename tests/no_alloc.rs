@@ -184,8 +184,9 @@ fn observing_every_shipped_model_allocates_nothing() {
 }
 
 /// The saltation Kalman filter through the same runs (impacts,
-/// accumulations, sliding, several contacts), and the likelihood helper's
-/// evaluations over a record: nothing allocates.
+/// accumulations, sliding, several contacts), with its defaults and told
+/// the plant (`with_plant_step`: one plant step at each impact), and the
+/// likelihood helper's evaluations over a record: nothing allocates.
 fn filter<M, const N: usize, const K: usize, const NU: usize>(
     model: &M,
     q0: SVector<f64, N>,
@@ -211,10 +212,13 @@ where
     let mut saltations = 0;
     let params = KalmanParams::new(50.0, 1e-7);
     let count = allocations(|| {
-        let mut f = SaltationKalman::<f64, N, K>::new(params, 0.0, q0, SVector::zeros()).unwrap();
-        for (tk, qk) in t.iter().zip(&q).skip(1) {
-            std::hint::black_box(f.update(model, *tk, qk, &u).unwrap());
-            saltations += f.kalman_report().saltations;
+        for knobs in [params, params.with_plant_step(1e-4)] {
+            let mut f =
+                SaltationKalman::<f64, N, K>::new(knobs, 0.0, q0, SVector::zeros()).unwrap();
+            for (tk, qk) in t.iter().zip(&q).skip(1) {
+                std::hint::black_box(f.update(model, *tk, qk, &u).unwrap());
+                saltations += f.kalman_report().saltations;
+            }
         }
         let record = (&t[..t.len().min(200)], &q[..q.len().min(200)]);
         std::hint::black_box(
