@@ -747,9 +747,7 @@ fn what_the_plants_step_alone_hides() {
     use common::phase::{TAU, oracle, plant, restarted};
     let sigma = 1e-4;
     let told = KalmanParams::new(20.0, sigma).with_plant_step(TAU);
-    let mut single = KalmanParams::new(20.0, sigma);
-    single.impact_delay = TAU / 2.0;
-    single.impact_time_sigma = TAU / 12f64.sqrt();
+    let single = one_delay(TAU, sigma);
     let (mut ratios, mut ratios_single, mut ratios_defaults) = (Vec::new(), Vec::new(), Vec::new());
     for (n, start) in random_example_1_starts(555, 12).into_iter().enumerate() {
         let run = plant(start, 10.0);
@@ -874,6 +872,18 @@ fn a_mean_impact_delay_moves_the_prediction_as_a_delayed_impact_does() {
     }
 }
 
+/// The filter's defaults for `σ`, told a plant's step of `tau` as one
+/// delay of position and velocity alike: `impact_delay` = τ/2 and
+/// `impact_time_sigma` = τ/√12, the moments of a delay uniform over a step
+/// (what `with_plant_step` replaced).
+fn one_delay(tau: f64, sigma: f64) -> KalmanParams<f64, 2> {
+    KalmanParams {
+        impact_delay: tau / 2.0,
+        impact_time_sigma: tau / 12f64.sqrt(),
+        ..KalmanParams::new(20.0, sigma)
+    }
+}
+
 /// Why [`KalmanParams::plant`] takes the plant's own step at each impact
 /// instead of delaying it by `τ/2`: the plant's impacts are exact impacts
 /// delayed by `τ/2 − s` in position but by `τ/(1 + e) − s` in velocity
@@ -913,9 +923,7 @@ fn a_single_delay_drifts_inside_an_accumulation() {
     let (tau, sigma) = (1e-5, 1e-4);
     let data = reference(&model, example_1_starts()[0], tau, 100, 4.6, &u);
     let bracket = common::runs::brackets(&data);
-    let mut single = KalmanParams::new(20.0, sigma);
-    single.impact_delay = tau / 2.0;
-    single.impact_time_sigma = tau / 12f64.sqrt();
+    let single = one_delay(tau, sigma);
     let knobs = [
         ("one delay", single),
         (
