@@ -422,14 +422,16 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     /// time grid, so the grid's phase is the only spread of their instants
     /// ([`KalmanParams::impact_time_sigma`] `0`, the plant adding
     /// `τ/√12`) and its own step the only offset
-    /// ([`KalmanParams::impact_delay`] `0`).
+    /// ([`KalmanParams::impact_delay`] `0`); its jumps follow the model's
+    /// own law through that step, so the relative error of a jump is `0`
+    /// too ([`KalmanParams::impact_noise`]; the phase is what is left).
     ///
     /// ```
     /// use moreau_runtime::KalmanParams;
     ///
     /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant_step(1e-5);
     /// assert_eq!(p.plant.map(|plant| plant.tau), Some(1e-5));
-    /// assert_eq!((p.impact_time_sigma, p.impact_delay), (0.0, 0.0));
+    /// assert_eq!((p.impact_noise, p.impact_time_sigma, p.impact_delay), (0.0, 0.0, 0.0));
     /// ```
     #[must_use]
     pub fn with_plant_step(self, tau: T) -> Self {
@@ -451,6 +453,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     pub fn with_plant(self, plant: StepParams<T>) -> Self {
         Self {
             plant: Some(plant),
+            impact_noise: T::zero(),
             impact_time_sigma: T::zero(),
             impact_delay: T::zero(),
             ..self
