@@ -725,21 +725,23 @@ fn the_plants_impacts_are_exact_impacts_delayed() {
 /// - the oracle meets the median (3e-5) and 90th percentile
 ///   (2e-4) on every run, so the plant's step, unknown at each impact,
 ///   does not by itself put them out of reach (the filter meets both on
-///   four of these twelve): what an estimator does not know before the
-///   impact adds the rest;
+///   four of these twelve with its defaults, on ten told the plant): what
+///   an estimator does not know before the impact adds the rest
+///   (`the_posterior_says_where_the_targets_are_out_of_reach`);
 /// - the filter, restarted as the oracle is from the exact state before
 ///   each impact and told the plant's step
 ///   ([`KalmanParams::with_plant_step`]: the plant's own step at each
-///   impact and the spread `τ/√12` of a uniform phase), is a Gaussian
-///   stand-in for that posterior: its median error in flight is within
-///   2.5 times the oracle's in the median over the runs and within 5
-///   times on each (measured 0.97 to 3.33, median 1.81). Told `τ/2` as one
-///   delay of position and velocity alike it is the same here (median
-///   1.81; printed): the velocity's own delay matters inside
+///   impact, the spread `τ/√12` of a uniform phase, exact jumps), is a
+///   Gaussian stand-in for that posterior and as good as it: its median
+///   error in flight is within 1.5 times the oracle's in the median over
+///   the runs and within 2.5 times on each (measured 0.95 to 1.71, median
+///   1.08). Told `τ/2` as one delay of position and velocity alike, with
+///   the default relative error of a jump (`ρ_i = 1e-5`, about 1e-4 m/s
+///   on these jumps), it is 1.81 (printed): the jump's error costs that
+///   much here, while the velocity's own delay matters inside
 ///   accumulations, which a restart at every impact does not let build up
 ///   (`a_single_delay_drifts_inside_an_accumulation`). With the defaults
-///   (no mean delay) it is about one and a half times further (median
-///   2.58; printed).
+///   (no mean delay) it is 2.58 (printed).
 ///
 /// `cargo test --release --test kalman -- --nocapture step_alone` (30 s)
 #[test]
@@ -794,7 +796,7 @@ fn what_the_plants_step_alone_hides() {
         );
         assert!(all.median <= 3e-5 && all.p90 <= 2e-4, "start {n}: {all:?}");
         let ratio = with_told.median / in_flight.median;
-        assert!(ratio <= 5.0, "start {n}: {ratio}");
+        assert!(ratio <= 2.5, "start {n}: {ratio}");
         ratios.push(ratio);
         ratios_single.push(with_single.median / in_flight.median);
         ratios_defaults.push(with_defaults.median / in_flight.median);
@@ -807,7 +809,7 @@ fn what_the_plants_step_alone_hides() {
     eprintln!(
         "restarted filter over the oracle in flight, median over the runs: told the step {told_median:.2}, told τ/2 as one delay {single_median:.2}, defaults {defaults_median:.2}"
     );
-    assert!(told_median <= 2.5, "{told_median}");
+    assert!(told_median <= 1.5, "{told_median}");
 }
 
 /// [`KalmanParams::impact_delay`]: a mean delay `δ̄` of each impact moves
@@ -909,7 +911,7 @@ fn one_delay(tau: f64, sigma: f64) -> KalmanParams<f64, 2> {
 /// Asserted: told the plant's step, the largest such error is at most a
 /// quarter of the one-delay filter's and at most 1e-2, on both sample
 /// sets. Measured: exact samples 3.7e-3 against 2.0e-2 (defaults 3.8e-3;
-/// means over the window 2.1e-3 against 5.7e-3), noisy samples 3.2e-3
+/// means over the window 2.1e-3 against 5.7e-3), noisy samples 2.9e-3
 /// against 1.75e-2 (defaults 2.8e-3). In a scratch run on the exact
 /// samples, the one-delay filter's `∇h·(v̂ − v)` at 4.434 s moved
 /// linearly with the delay, by 6.5e-3 to 6.9e-3 m/s per microsecond
@@ -1514,7 +1516,9 @@ fn example_1_figures_beside_the_reduced_order_observer() {
 /// 90th percentile ≤ 2e-4 together hold on 15 of the 48 (median 1.1e-5
 /// to 7.3e-5, 90th percentile 8.5e-5 to 3.4e-4; 13 before held contacts
 /// stopped doing work on a separating estimate); told the plant's step,
-/// on 23 of the 48. A throw-away run of the
+/// on 33 of the 48, and where it misses, the Gaussian posterior of the
+/// plant's own noise misses or nearly misses as well
+/// (`the_posterior_says_where_the_targets_are_out_of_reach`). A throw-away run of the
 /// same 48 against the plant at `τ = 1e-6`, with `σ_t` set to that
 /// plant's `τ/√12 = 0.29 µs`, met both on 40 of 48 (median up to 4.0e-5,
 /// 90th percentile up to 2.3e-4 on the others): most of the gap is the
@@ -1601,6 +1605,100 @@ fn example_1_random_starts_beside_the_reduced_order_observer() {
     eprintln!(
         "the issue's median and 90th percentile met by the filter on {met} of {runs} runs (told the plant's step: {met_step}); (38)'s maximum off the brackets at most 0.1 on {met_38} of {runs}"
     );
+}
+
+/// Where the filter misses the median or 90th percentile, the
+/// samples do not hold more: the Gaussian posterior of the plant's own
+/// noise (`tests/common/posterior.rs`: the measurement noise and the
+/// phase of the plant's step at each impact, linearised along the truth)
+/// bounds the fraction of samples any estimator can expect within a
+/// radius, and so the smallest median and 90th percentile it can expect
+/// over a run (`q50`, `q90`). On the 52 Example 1 runs of
+/// `example_1_figures_beside_the_reduced_order_observer` (noise seeds 11
+/// to 14) and `example_1_random_starts_beside_the_reduced_order_observer`
+/// (seeds 555, 777, 999 and 1234, noise seeds `100 + n`), σ = 1e-4, the
+/// filter told the plant (`with_plant_step(1e-5)`):
+///
+/// - `within` is exact where the answer is known: for `P = λ I`, `1 −
+///   exp(−r²/2λ)`;
+/// - the filter's median and 90th percentile are within three times
+///   `q50` and `q90` on every run, and within 1.25 times in the median
+///   over the runs (measured 0.63 to 2.46 and 0.49 to 2.25, within 1.5
+///   on both on 44 of the 52; medians over the runs 1.05 and 0.99). The
+///   largest ratio is the file's start, which slides for most of the
+///   window: the posterior leaves out the sliding plant's drift, which
+///   the filter's contact noise stands for;
+/// - on 12 of the 48 random starts `q50` is above 3e-5 or `q90` above
+///   2e-4 (printed; asserted: on at least one): there, in expectation
+///   over the noise, no estimator meets the numbers; a given
+///   draw may (the filter does on 3 of them);
+/// - every run on which the filter misses the median or the 90th
+///   percentile is one on which `q50` or `q90` comes within 1.5 times of
+///   its target, as a single draw's quantile does of the expected one on
+///   most runs (above). Measured: the filter misses on 15 of the 48; on
+///   the 6 of them where the posterior's quantiles are within the
+///   targets, the nearer comes to 0.74 to 0.96 of its target.
+///
+/// `cargo test --release --test kalman -- --nocapture posterior` (40 s)
+#[test]
+fn the_posterior_says_where_the_targets_are_out_of_reach() {
+    use common::posterior::{quantile, velocity_covariances, within};
+    for (lambda, r) in [(1e-10_f64, 1e-5_f64), (4e-8, 3e-4), (1e-9, 1e-6)] {
+        let exact = 1.0 - (-r * r / (2.0 * lambda)).exp();
+        let p = nalgebra::Matrix2::identity() * lambda;
+        assert!((within(&p, r) - exact).abs() < 1e-12, "{lambda:e} {r:e}");
+    }
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let sigma = 1e-4;
+    let told = KalmanParams::new(20.0, sigma).with_plant_step(1e-5);
+    let mut runs: Vec<(String, Start, u64)> = example_1_starts()
+        .into_iter()
+        .enumerate()
+        .map(|(n, start)| (format!("start {n}"), start, 11 + n as u64))
+        .collect();
+    for seed in [555, 777, 999, 1234] {
+        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
+            runs.push((format!("seed {seed}, start {n}"), start, 100 + n as u64));
+        }
+    }
+    let (mut medians, mut p90s) = (Vec::new(), Vec::new());
+    let (mut out_of_reach, mut missed) = (0, 0);
+    for (at, start, noise_seed) in &runs {
+        let data = reference(&model, *start, 1e-5, 100, 10.0, &u);
+        let filter = with_params(&data, &measure(&data, sigma, *noise_seed), told);
+        let covariances = velocity_covariances(&data, sigma, 1e-5, WINDOW);
+        let (q50, q90) = (quantile(&covariances, 0.5), quantile(&covariances, 0.9));
+        let (median, p90) = (filter.all.median, filter.all.p90);
+        let misses = median > 3e-5 || p90 > 2e-4;
+        let beyond = q50 > 3e-5 || q90 > 2e-4;
+        eprintln!(
+            "{at}: posterior q50 {q50:.2e} q90 {q90:.2e}{}; filter median {median:.2e} ({:.2}×) p90 {p90:.2e} ({:.2}×){}",
+            if beyond { " (beyond the issue's)" } else { "" },
+            median / q50,
+            p90 / q90,
+            if misses { " (misses 3e-5 / 2e-4)" } else { "" },
+        );
+        assert!(median <= 3.0 * q50 && p90 <= 3.0 * q90, "{at}");
+        if at.starts_with("seed") {
+            out_of_reach += usize::from(beyond);
+            missed += usize::from(misses);
+        }
+        if misses {
+            assert!(
+                1.5 * q50 >= 3e-5 || 1.5 * q90 >= 2e-4,
+                "{at}: the filter misses where the posterior does not come near"
+            );
+        }
+        medians.push(median / q50);
+        p90s.push(p90 / q90);
+    }
+    let (over_median, over_p90) = (figures(&medians).median, figures(&p90s).median);
+    eprintln!(
+        "the filter over the posterior, median over the runs: median {over_median:.2}, p90 {over_p90:.2}; of the 48 random starts, the posterior's expected quantiles beyond the issue's on {out_of_reach}, the filter missing on {missed}"
+    );
+    assert!(over_median <= 1.25 && over_p90 <= 1.25);
+    assert!(out_of_reach >= 1);
 }
 
 moreau::model! {

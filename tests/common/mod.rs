@@ -4,6 +4,7 @@
 pub mod casadi;
 pub mod exact;
 pub mod phase;
+pub mod posterior;
 pub mod runs;
 
 use std::path::PathBuf;
