@@ -24,8 +24,24 @@ pub struct Reference<const N: usize> {
 /// `every`-th state.
 pub fn reference<M, const N: usize, const K: usize>(
     model: &M,
-    (q0, v0): (SVector<f64, N>, SVector<f64, N>),
+    start: (SVector<f64, N>, SVector<f64, N>),
     tau: f64,
+    every: usize,
+    t_end: f64,
+    u: &M::Input,
+) -> Reference<N>
+where
+    M: Model<N, K, Scalar = f64>,
+{
+    reference_with(model, start, StepParams::new(tau), every, t_end, u)
+}
+
+/// [`reference`] for a plant with other settings than the defaults
+/// (Siconos's law, for one: [`StepParams::siconos`]).
+pub fn reference_with<M, const N: usize, const K: usize>(
+    model: &M,
+    (q0, v0): (SVector<f64, N>, SVector<f64, N>),
+    params: StepParams<f64>,
     every: usize,
     t_end: f64,
     u: &M::Input,
@@ -38,7 +54,8 @@ where
         model.gaps(&q0).iter().all(|&h| h >= 0.0),
         "infeasible start {q0}"
     );
-    let stepper = MoreauJean::new(StepParams::new(tau)).unwrap();
+    let tau = params.tau;
+    let stepper = MoreauJean::new(params).unwrap();
     let mut state = State::new(0.0, q0, v0);
     let mut samples = vec![state];
     let mut impacts = Vec::new();
