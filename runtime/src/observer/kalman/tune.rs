@@ -79,7 +79,10 @@ pub struct Tuning<T: RealField + Copy, const N: usize> {
 /// four noise knobs scaled by a factor `10^x`, `x ∈ [lo, hi]`, and the
 /// delay shifted by `y σ_t`, `y ∈ [−3, 3]` (`σ_t` the given
 /// [`KalmanParams::impact_time_sigma`]; with `σ_t = 0` the delay stays
-/// where it is). Coordinate ascent: a first sweep with a grid of seven
+/// where it is). A knob given as zero stays zero (a factor cannot move
+/// it), as those [`KalmanParams::with_plant_step`] sets do: a plant's
+/// exact jumps, and no timing spread beyond its grid's.
+/// Coordinate ascent: a first sweep with a grid of seven
 /// points per knob and golden-section search around the best, a second
 /// with golden-section search around the first's point.
 /// Each evaluation runs a filter over the record from `(t[0], q[0])` with
