@@ -1756,16 +1756,7 @@ fn the_posterior_says_where_the_targets_are_out_of_reach() {
     let u = SVector::zeros();
     let sigma = 1e-4;
     let told = KalmanParams::new(20.0, sigma).with_plant_step(1e-5);
-    let mut runs: Vec<(String, Start, u64)> = example_1_starts()
-        .into_iter()
-        .enumerate()
-        .map(|(n, start)| (format!("start {n}"), start, 11 + n as u64))
-        .collect();
-    for seed in [555, 777, 999, 1234] {
-        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
-            runs.push((format!("seed {seed}, start {n}"), start, 100 + n as u64));
-        }
-    }
+    let runs = common::runs::example_1_runs();
     let (mut medians, mut p90s) = (Vec::new(), Vec::new());
     let (mut out_of_reach, mut missed) = (0, 0);
     for (at, start, noise_seed) in &runs {

@@ -11,8 +11,8 @@ use moreau::{Estimate, Model, Observer, ObserverParams, ReducedOrder};
 mod common;
 
 use common::runs::{
-    Reference, Scored, brackets, errors, example_1_starts, first_at_or_after, measure,
-    random_example_1_starts, reference, score,
+    Reference, Scored, brackets, errors, example_1_runs, example_1_starts, first_at_or_after,
+    measure, reference, score,
 };
 use moreau_models::{DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::{SMatrix, SVector};
@@ -221,16 +221,7 @@ fn timing_bound(model: &Parabola<f64>, state: &moreau::State<f64, 2>, i: usize, 
 fn an_impact_is_timed_as_well_as_the_noise_allows() {
     let model = Parabola::<f64>::new();
     let (sigma, period) = (1e-4, 1e-3);
-    let mut runs: Vec<_> = example_1_starts()
-        .into_iter()
-        .enumerate()
-        .map(|(n, start)| (format!("start {n}"), start, 11 + n as u64))
-        .collect();
-    for seed in [555, 777, 999, 1234] {
-        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
-            runs.push((format!("seed {seed}, start {n}"), start, 100 + n as u64));
-        }
-    }
+    let runs = example_1_runs();
     let (mut checked, mut above, mut worst) = (0, 0, (0.0_f64, 0.0, 0.0, 0.0));
     let mut failed = Vec::new();
     for (name, start, seed) in runs {

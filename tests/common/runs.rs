@@ -269,3 +269,24 @@ pub fn random_example_1_starts(seed: u64, count: usize) -> Vec<(SVector<f64, 2>,
         })
         .collect()
 }
+
+/// An initial state `(q0, v0)` of a two-coordinate model.
+pub type Start2 = (SVector<f64, 2>, SVector<f64, 2>);
+
+/// The 52 Example 1 runs the tests score the numbers on, each
+/// with its name and its noise seed: the four of [`example_1_starts`]
+/// (noise seeds 11 to 14), then twelve [`random_example_1_starts`] of
+/// each of the seeds 555, 777, 999 and 1234 (noise seeds `100 + n`).
+pub fn example_1_runs() -> Vec<(String, Start2, u64)> {
+    let mut runs: Vec<_> = example_1_starts()
+        .into_iter()
+        .enumerate()
+        .map(|(n, start)| (format!("start {n}"), start, 11 + n as u64))
+        .collect();
+    for seed in [555, 777, 999, 1234] {
+        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
+            runs.push((format!("seed {seed}, start {n}"), start, 100 + n as u64));
+        }
+    }
+    runs
+}

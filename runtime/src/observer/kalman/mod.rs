@@ -211,7 +211,9 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// `ρ_i² (ΔvᵀMΔv/N) M⁻¹`, isotropic in the kinetic-energy metric with
     /// `ρ_i²` times the jump's energy (module `propagate`). Default `1e-5`:
     /// a restitution coefficient and a contact normal known to about
-    /// 0.001 %, as a rigid model of a rigid plant knows them.
+    /// 0.001 %, as a rigid model of a rigid plant knows them;
+    /// [`KalmanParams::with_plant_step`] sets `0`, the plant's jumps being
+    /// the model's law through its step.
     pub impact_noise: T,
     /// Standard deviation `σ_t` of an impact's instant, in seconds: the
     /// filter takes every impact to be instantaneous and at the located
