@@ -1031,18 +1031,23 @@ fn a_plant_with_siconoss_law_is_told_its_own_step() {
             let mut filter =
                 SaltationKalman::<f64, 2, 2>::new(*params, 0.0, measured[0], Vector2::zeros())
                     .unwrap();
-            let mut estimates = vec![filter.estimate()];
             let mut nees = Vec::new();
-            for (s, q) in data.samples.iter().zip(&measured).skip(1) {
-                let e = filter.update(&model, s.t, q, &u).unwrap();
-                if (WINDOW.0..WINDOW.1).contains(&s.t) {
-                    let error = e.v - s.v;
-                    let p = filter.covariance().vv.cholesky().unwrap();
-                    nees.push(error.dot(&p.solve(&error)));
-                }
-                estimates.push(e);
-            }
-            let sc = score(&data, &estimates, WINDOW);
+            let counted = run_counting(
+                &mut filter,
+                &model,
+                (&data, &measured),
+                &u,
+                WINDOW,
+                |j, f| {
+                    let s = &data.samples[j];
+                    if (WINDOW.0..WINDOW.1).contains(&s.t) {
+                        let error = f.estimate().v - s.v;
+                        let p = f.covariance().vv.cholesky().unwrap();
+                        nees.push(error.dot(&p.solve(&error)));
+                    }
+                },
+            );
+            let sc = counted.scored;
             let nees_median = figures(&nees).median;
             met[k] += usize::from(sc.all.median <= 3e-5 && sc.all.p90 <= 2e-4);
             nees_medians[k].push(nees_median);

@@ -442,12 +442,12 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
 
     /// [`KalmanParams::with_plant_step`] for a plant with other settings
     /// than the defaults (Siconos's law, for one:
-    /// [`ApproachVelocity::Start`](crate::ApproachVelocity::Start)).
+    /// [`StepParams::siconos`]).
     ///
     /// ```
-    /// use moreau_runtime::{ApproachVelocity, KalmanParams, StepParams};
+    /// use moreau_runtime::{KalmanParams, StepParams};
     ///
-    /// let siconos = StepParams::new(1e-5).with_approach_velocity(ApproachVelocity::Start);
+    /// let siconos = StepParams::siconos(1e-5);
     /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant(siconos);
     /// assert_eq!(p.plant, Some(siconos));
     /// ```

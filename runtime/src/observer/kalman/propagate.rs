@@ -586,8 +586,8 @@ where
             },
         };
         // a gap's root timed the impact: it has an instant, uncertain by
-        // σ_t (and a plant's step) and late on average by δ̄ (and by its
-        // step's mean delays); a closure the LCP makes at the start of a
+        // σ_t (and a plant's step grid) and late on average by δ̄ (or by
+        // a plant's own step); a closure the LCP makes at the start of a
         // piece has neither
         let timed = guard.is_some();
         let noise = self.impact_noise(&s, timed, jump.p, &w)?;
@@ -597,7 +597,7 @@ where
             .add(&noise)
             .symmetrized();
         self.carry_offset(&s.matrix);
-        if guard.is_some() {
+        if timed {
             // a mean delay moves the state along `d`; a plant's step, by
             // its own error at the impact (module docs, "A time-stepping
             // plant"), or where its step fails by half a step along `d`
