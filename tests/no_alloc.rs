@@ -185,8 +185,10 @@ fn observing_every_shipped_model_allocates_nothing() {
 
 /// The saltation Kalman filter through the same runs (impacts,
 /// accumulations, sliding, several contacts), with its defaults and told
-/// the plant (`with_plant_step`: one plant step at each impact), and the
-/// likelihood helper's evaluations over a record: nothing allocates.
+/// the plant (`with_plant_step`: one plant step at each impact; and
+/// Siconos's law, `with_plant(StepParams::siconos(…))`: two more on each
+/// piece of a slide), and the likelihood helper's evaluations over a
+/// record: nothing allocates.
 fn filter<M, const N: usize, const K: usize, const NU: usize>(
     model: &M,
     q0: SVector<f64, N>,
@@ -212,7 +214,11 @@ where
     let mut saltations = 0;
     let params = KalmanParams::new(50.0, 1e-7);
     let count = allocations(|| {
-        for knobs in [params, params.with_plant_step(1e-4)] {
+        for knobs in [
+            params,
+            params.with_plant_step(1e-4),
+            params.with_plant(StepParams::siconos(1e-4)),
+        ] {
             let mut f =
                 SaltationKalman::<f64, N, K>::new(knobs, 0.0, q0, SVector::zeros()).unwrap();
             for (tk, qk) in t.iter().zip(&q).skip(1) {

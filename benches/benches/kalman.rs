@@ -3,9 +3,11 @@
 //! backward finite difference of the samples (the estimators of the noise
 //! sweep's table), in one run, on Example 1 sampled at 1 kHz
 //! with σ = 1e-4: in free flight, with an impact inside the interval, and
-//! sliding. The filter runs with its defaults and told the plant's step
+//! sliding. The filter runs with its defaults, told the plant's step
 //! (`KalmanParams::with_plant_step`, which takes one step of the plant
-//! at each impact). Each estimator is first run over the record up to the
+//! at each impact), and told Siconos's law (`KalmanParams::with_plant`
+//! with `StepParams::siconos`, which also takes two plant steps on each
+//! piece of a slide, its law's drag there). Each estimator is first run over the record up to the
 //! interval, so it starts from its own converged state; the copy of it
 //! that each timed update starts from is made outside the timed region.
 //!
@@ -74,6 +76,13 @@ fn updates(c: &mut Criterion) {
             Vector2::zeros(),
         )
         .unwrap();
+        let mut siconos = SaltationKalman::<f64, 2, 2>::new(
+            kalman_params.with_plant(StepParams::siconos(1e-5)),
+            0.0,
+            data[0].1,
+            Vector2::zeros(),
+        )
+        .unwrap();
         let observer_params = ObserverParams::new(10.0, 20.0).with_noise(1e-4);
         let mut reduced =
             ReducedOrder::<f64, 2, 2>::new(observer_params, 0.0, data[0].1, Vector2::zeros())
@@ -85,6 +94,7 @@ fn updates(c: &mut Criterion) {
         for (t, q, _) in &data[1..k] {
             kalman.update(&model, *t, q, &u).unwrap();
             stepped.update(&model, *t, q, &u).unwrap();
+            siconos.update(&model, *t, q, &u).unwrap();
             reduced.update(&model, *t, q, &u).unwrap();
             full.update(&model, *t, q, &u).unwrap();
         }
@@ -120,6 +130,16 @@ fn updates(c: &mut Criterion) {
             |b| {
                 b.iter_batched_ref(
                     || stepped,
+                    |f| f.update(&model, black_box(t), &q, &u).unwrap(),
+                    BatchSize::SmallInput,
+                )
+            },
+        );
+        group.bench_function(
+            format!("saltation Kalman told Siconos's law, {label}"),
+            |b| {
+                b.iter_batched_ref(
+                    || siconos,
                     |f| f.update(&model, black_box(t), &q, &u).unwrap(),
                     BatchSize::SmallInput,
                 )

@@ -262,7 +262,13 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// does. Telling the filter `τ/2` as one delay of position and
     /// velocity instead leaves the law's error, which inside an
     /// accumulation of impacts builds up into an error the samples hardly
-    /// see (module `propagate`, "A time-stepping plant").
+    /// see (module `propagate`, "A time-stepping plant"). Along a slide,
+    /// a plant whose law is not the default
+    /// ([`ApproachVelocity::Midpoint`](crate::ApproachVelocity::Midpoint))
+    /// drags (Siconos's does, on a curved surface), and the filter adds
+    /// that drag, one step of the plant against one with the default law
+    /// on each piece of the slide (module `propagate`, "A plant's law
+    /// along a slide").
     /// [`KalmanParams::with_plant_step`] and [`KalmanParams::with_plant`]
     /// set it.
     pub plant: Option<StepParams<T>>,
