@@ -680,17 +680,40 @@ where
     if plant.approach_velocity == ApproachVelocity::Midpoint {
         return None;
     }
-    let step = |params: StepParams<T>| -> Option<State<T, N>> {
-        let mut state = State::new(t, *q, *v);
-        MoreauJean::new(params)
-            .ok()?
-            .step(model, &mut state, u)
-            .ok()?;
-        Some(state)
-    };
-    let plants = step(plant)?;
-    let holding = step(plant.with_approach_velocity(ApproachVelocity::Midpoint))?;
-    let error = (plants.q - holding.q, plants.v - holding.v);
+    let plants = plant_step(model, u, (t, q, v), plant)?;
+    let holding = plant_step(
+        model,
+        u,
+        (t, q, v),
+        plant.with_approach_velocity(ApproachVelocity::Midpoint),
+    )?;
+    finite((plants.q - holding.q, plants.v - holding.v))
+}
+
+/// One step of the plant `plant` from `(q, v)` at `t`; `None` where its
+/// settings are refused or the step fails.
+fn plant_step<M, T, const N: usize, const K: usize>(
+    model: &M,
+    u: &M::Input,
+    (t, q, v): (T, &SVector<T, N>, &SVector<T, N>),
+    plant: StepParams<T>,
+) -> Option<State<T, N>>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    let mut state = State::new(t, *q, *v);
+    MoreauJean::new(plant)
+        .ok()?
+        .step(model, &mut state, u)
+        .ok()?;
+    Some(state)
+}
+
+/// A plant's error `(Δq, Δv)`, or `None` where it is not finite.
+fn finite<T: RealField + Copy, const N: usize>(
+    error: (SVector<T, N>, SVector<T, N>),
+) -> Option<(SVector<T, N>, SVector<T, N>)> {
     (error.0.iter().chain(error.1.iter()).all(|x| x.is_finite())).then_some(error)
 }
 
@@ -710,16 +733,13 @@ where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
-    let plant_step = plant.tau;
-    let stepper = MoreauJean::new(plant).ok()?;
-    let mut state = State::new(t, *q, *v_minus);
-    stepper.step(model, &mut state, u).ok()?;
+    let tau = plant.tau;
+    let state = plant_step(model, u, (t, q, v_minus), plant)?;
     let (mass, forces) = model.dynamics(t, q, v_plus, u);
     let chol = factor_mass(&mass).ok()?;
     let accel = -chol.solve(&forces);
     let half: T = nalgebra::convert(0.5);
-    let q_exact = q + v_plus * plant_step + accel * (half * plant_step * plant_step);
-    let v_exact = v_plus + accel * plant_step;
-    let error = (state.q - q_exact, state.v - v_exact);
-    (error.0.iter().chain(error.1.iter()).all(|x| x.is_finite())).then_some(error)
+    let q_exact = q + v_plus * tau + accel * (half * tau * tau);
+    let v_exact = v_plus + accel * tau;
+    finite((state.q - q_exact, state.v - v_exact))
 }
