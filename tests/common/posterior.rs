@@ -69,9 +69,19 @@ pub fn velocity_covariances(
 /// smooth and periodic; on these runs' covariances the quantiles below
 /// moved by under 0.1 % from 64 to 1024 points).
 pub fn within(p: &Matrix2<f64>, r: f64) -> f64 {
-    const POINTS: usize = 64;
+    within_spread(spread(p), r)
+}
+
+/// The eigenvalues of `p`, held at zero from below: all [`within`] needs
+/// of it, computed once per covariance by [`quantile`].
+fn spread(p: &Matrix2<f64>) -> (f64, f64) {
     let eig = p.symmetric_eigenvalues();
-    let (l1, l2) = (eig[0].max(0.0), eig[1].max(0.0));
+    (eig[0].max(0.0), eig[1].max(0.0))
+}
+
+/// [`within`] from the eigenvalues `(λ₁, λ₂)` ([`spread`]).
+fn within_spread((l1, l2): (f64, f64), r: f64) -> f64 {
+    const POINTS: usize = 64;
     let mut sum = 0.0;
     for j in 0..POINTS {
         let theta = std::f64::consts::PI * (j as f64 + 0.5) / POINTS as f64;
@@ -89,8 +99,9 @@ pub fn within(p: &Matrix2<f64>, r: f64) -> f64 {
 /// expect within `r`, the mean of [`within`] over `covariances`, is
 /// `fraction` (module docs), by bisection in `log r` over 1e-9 to 1 m/s.
 pub fn quantile(covariances: &[Matrix2<f64>], fraction: f64) -> f64 {
+    let spreads: Vec<_> = covariances.iter().map(spread).collect();
     let expected =
-        |r: f64| covariances.iter().map(|p| within(p, r)).sum::<f64>() / covariances.len() as f64;
+        |r: f64| spreads.iter().map(|&l| within_spread(l, r)).sum::<f64>() / spreads.len() as f64;
     let (mut lo, mut hi) = (1e-9_f64, 1.0_f64);
     for _ in 0..30 {
         let mid = (lo * hi).sqrt();
