@@ -143,6 +143,7 @@
 //! model's generated [`Model::linearization`](crate::Model::linearization) and [`Sensitivities`].
 
 mod blocks;
+mod grid;
 mod propagate;
 mod saltation;
 mod tune;
@@ -252,11 +253,18 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// velocity comes `τ (1/(1 + e) − 1/2)` later than the position; where
     /// forces depend on the velocity, as a robot's do, the error has
     /// another shape). So at each impact a gap's root timed, the filter
-    /// takes one step of this plant from the impact, the gap closing at
-    /// the step's start (the middle of where it closes for the plant, over
-    /// a step, to first order), and moves its prediction by that step's
-    /// end against the exact impact's at the same time; the spread of
-    /// where the gap closes in a step, `τ/√12`, adds to
+    /// takes one step of this plant across the impact and moves its
+    /// prediction by that step's end against the exact impact's at the
+    /// same time. Where the samples are the plant's states at its own
+    /// steps ([`KalmanParams::plant_grid`], and the interval a whole
+    /// number of steps), the filter knows the step the impact falls in:
+    /// the step starts on the plant's grid, and the deviation of the
+    /// predicted instant (from the covariance) says how likely the
+    /// neighbouring step is, which the filter takes in by the Gaussian
+    /// moments of that choice (module `grid`). Otherwise the step starts
+    /// at the impact, the gap closing at its start (the middle of where it
+    /// closes for the plant, over a step, to first order), and the spread
+    /// of where the gap closes in a step, `τ/√12`, adds to
     /// [`KalmanParams::impact_time_sigma`] in quadrature. Where that one
     /// step fails, the prediction moves as an impact half a step late
     /// does. Telling the filter `τ/2` as one delay of position and
@@ -272,6 +280,16 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// [`KalmanParams::with_plant_step`] and [`KalmanParams::with_plant`]
     /// set it.
     pub plant: Option<StepParams<T>>,
+    /// Whether the samples are the [`plant`](KalmanParams::plant)'s states
+    /// at its own steps (default `true`), as a simulation that records
+    /// every `n`-th state gives them: the plant's step grid then passes
+    /// through every sample time, and where an interval is a whole number
+    /// of the plant's steps (to a thousandth of a step) the filter takes
+    /// each impact into the step the plant takes it into, rather than a
+    /// step anywhere around it. Set it `false` for samples taken between
+    /// the plant's steps (interpolated, or timed by another clock).
+    /// Without a plant it does nothing.
+    pub plant_grid: bool,
     /// Relative accuracy `ρ_c` of a persistent contact's force, as a
     /// density (units √s): along a piece of sliding or resting contact
     /// with contact acceleration `a_c = M⁻¹Jᵀλ`, white acceleration noise
@@ -402,6 +420,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             impact_time_sigma: nalgebra::convert(3e-6),
             impact_delay: T::zero(),
             plant: None,
+            plant_grid: true,
             contact_noise: nalgebra::convert(1e-6),
             band_sigmas: T::one(),
         }
@@ -427,12 +446,13 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     /// The same settings for samples of a simulated rigid plant,
     /// [`MoreauJean`](crate::MoreauJean) at the step `tau` with its default settings
     /// ([`KalmanParams::plant`]): its impacts are instantaneous on its own
-    /// time grid, so the grid's phase is the only spread of their instants
-    /// ([`KalmanParams::impact_time_sigma`] `0`, the plant adding
-    /// `τ/√12`) and its own step the only offset
+    /// time grid, so the grid is the only spread of their instants
+    /// ([`KalmanParams::impact_time_sigma`] `0`: on the samples' grid,
+    /// [`KalmanParams::plant_grid`], the step each impact falls in; off
+    /// it, a phase of `τ/√12`) and its own step the only offset
     /// ([`KalmanParams::impact_delay`] `0`); its jumps follow the model's
     /// own law through that step, so the relative error of a jump is `0`
-    /// too ([`KalmanParams::impact_noise`]; the phase is what is left).
+    /// too ([`KalmanParams::impact_noise`]; the step is what is left).
     ///
     /// ```
     /// use moreau_runtime::KalmanParams;
@@ -444,6 +464,21 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     #[must_use]
     pub fn with_plant_step(self, tau: T) -> Self {
         self.with_plant(StepParams::new(tau))
+    }
+
+    /// The same settings with [`KalmanParams::plant_grid`]: `false` for
+    /// samples of the plant taken between its steps.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanParams;
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant_step(1e-5);
+    /// assert!(p.plant_grid);
+    /// assert!(!p.with_plant_grid(false).plant_grid);
+    /// ```
+    #[must_use]
+    pub fn with_plant_grid(self, plant_grid: bool) -> Self {
+        Self { plant_grid, ..self }
     }
 
     /// [`KalmanParams::with_plant_step`] for a plant with other settings
@@ -1218,8 +1253,13 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     where
         M: Sensitivities<N, K, Scalar = T>,
     {
-        let mut propagation =
-            Propagation::new(interval.model, interval.u, self.t, &self.params, self.p);
+        let mut propagation = Propagation::new(
+            interval.model,
+            interval.u,
+            (self.t, interval.tau),
+            &self.params,
+            self.p,
+        );
         if self.fresh {
             propagation = propagation.relinearised((self.q - q, v0 - w));
         }
