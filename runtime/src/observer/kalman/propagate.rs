@@ -723,31 +723,24 @@ where
         let timed = guard.is_some();
         // a plant whose grid passes through the samples: the window its
         // step falls in, and the staircase's moments (module `grid`)
-        if let (Some(plant), Some(g)) = (self.plant.filter(|_| self.on_grid), guard)
-            && let Some(on_grid) = self.on_grid_impact(jump, (&w, &s), g, plant)
-        {
-            let noise = self
-                .impact_noise(&s, false, jump.p, &w)?
-                .add(&Blocks::outer(&s.timing.0, &s.timing.1).scaled(on_grid.residual));
-            self.p = on_grid
-                .map
-                .congruence_covered(&self.p)
-                .add(&noise)
-                .symmetrized();
-            self.carry_offset(&on_grid.map);
+        let on_grid = match (self.plant.filter(|_| self.on_grid), guard) {
+            (Some(plant), Some(g)) => self.on_grid_impact(jump, (&w, &s), g, plant),
+            _ => None,
+        };
+        let (map, noise) = match &on_grid {
+            Some(on_grid) => (
+                on_grid.map,
+                self.impact_noise(&s, false, jump.p, &w)?
+                    .add(&Blocks::outer(&s.timing.0, &s.timing.1).scaled(on_grid.residual)),
+            ),
+            None => (s.matrix, self.impact_noise(&s, timed, jump.p, &w)?),
+        };
+        self.p = map.congruence_covered(&self.p).add(&noise).symmetrized();
+        self.carry_offset(&map);
+        if let Some(on_grid) = on_grid {
             self.offset.0 += on_grid.offset.0;
             self.offset.1 += on_grid.offset.1;
-            self.saltations += 1;
-            return Ok(());
-        }
-        let noise = self.impact_noise(&s, timed, jump.p, &w)?;
-        self.p = s
-            .matrix
-            .congruence_covered(&self.p)
-            .add(&noise)
-            .symmetrized();
-        self.carry_offset(&s.matrix);
-        if timed {
+        } else if timed {
             // a mean delay moves the state along `d`; a plant's step, by
             // its own error at the impact (module docs, "A time-stepping
             // plant"), or where its step fails by half a step along `d`
@@ -840,22 +833,24 @@ fn finite<T: RealField + Copy, const N: usize>(
     (error.0.iter().chain(error.1.iter()).all(|x| x.is_finite())).then_some(error)
 }
 
-/// The state just after an exact impact at `t` (`v⁺` at `q`) flown
-/// freely over `r`, to second order.
-fn exact_after<M, T, const N: usize, const K: usize>(
+/// The free motion from `(q, v)` at `t` over `r` (back in time where `r`
+/// is negative), to second order: the exact impact's state flown to a
+/// plant step's end, or the motion before an impact taken back to the
+/// step's start.
+fn flown<M, T, const N: usize, const K: usize>(
     model: &M,
     u: &M::Input,
-    (t, q, v_plus): (T, &SVector<T, N>, &SVector<T, N>),
+    (t, q, v): (T, &SVector<T, N>, &SVector<T, N>),
     r: T,
 ) -> Option<(SVector<T, N>, SVector<T, N>)>
 where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
-    let (mass, forces) = model.dynamics(t, q, v_plus, u);
+    let (mass, forces) = model.dynamics(t, q, v, u);
     let accel = -factor_mass(&mass).ok()?.solve(&forces);
     let half: T = nalgebra::convert(0.5);
-    Some((q + v_plus * r + accel * (half * r * r), v_plus + accel * r))
+    Some((q + v * r + accel * (half * r * r), v + accel * r))
 }
 
 /// The plant's error at an impact whose instant `t` falls `phase` after
@@ -875,14 +870,8 @@ where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
-    let (mass, forces) = model.dynamics(t, q, v_minus, u);
-    let accel = -factor_mass(&mass).ok()?.solve(&forces);
-    let half: T = nalgebra::convert(0.5);
-    let mut state = State::new(
-        t - phase,
-        q - v_minus * phase + accel * (half * phase * phase),
-        v_minus - accel * phase,
-    );
+    let (q_start, v_start) = flown(model, u, (t, q, v_minus), -phase)?;
+    let mut state = State::new(t - phase, q_start, v_start);
     let report = MoreauJean::new(plant)
         .ok()?
         .step(model, &mut state, u)
@@ -890,7 +879,7 @@ where
     if !report.impacting().contains(guard) {
         return None;
     }
-    let (q_exact, v_exact) = exact_after(model, u, (t, q, v_plus), plant.tau - phase)?;
+    let (q_exact, v_exact) = flown(model, u, (t, q, v_plus), plant.tau - phase)?;
     finite((state.q - q_exact, state.v - v_exact))
 }
 
@@ -911,6 +900,6 @@ where
     M: Sensitivities<N, K, Scalar = T>,
 {
     let state = plant_step(model, u, (t, q, v_minus), plant)?;
-    let (q_exact, v_exact) = exact_after(model, u, (t, q, v_plus), plant.tau)?;
+    let (q_exact, v_exact) = flown(model, u, (t, q, v_plus), plant.tau)?;
     finite((state.q - q_exact, state.v - v_exact))
 }
