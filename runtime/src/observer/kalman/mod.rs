@@ -288,7 +288,9 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// each impact into the step the plant takes it into, rather than a
     /// step anywhere around it. Set it `false` for samples taken between
     /// the plant's steps (interpolated, or timed by another clock).
-    /// Without a plant it does nothing.
+    /// Without a plant it does nothing. In `f32`, sample times of a few
+    /// seconds round by more than a thousandth of a 10 µs step, and the
+    /// filter stays off the grid there (`tests/kalman.rs`, `runs_in_f32`).
     pub plant_grid: bool,
     /// Relative accuracy `ρ_c` of a persistent contact's force, as a
     /// density (units √s): along a piece of sliding or resting contact
