@@ -156,7 +156,7 @@ use crate::lcp::{IndexSet, Lcp};
 use crate::linalg::Ldlt;
 use crate::model::Sensitivities;
 use crate::state::State;
-use crate::stepper::{ApproachVelocity, MoreauJean, StepParams};
+use crate::stepper::{ApproachVelocity, MoreauJean, StepParams, StepReport};
 use crate::validate::{self, factor_mass};
 
 use super::super::ObserverError;
@@ -495,13 +495,8 @@ where
             guard,
         )?;
         let stairs = staircase(tau, lower, sigma_state, self.machine_timing);
-        let reset = Blocks {
-            qq: SMatrix::identity(),
-            qv: SMatrix::zeros(),
-            vq: s.reset_dq,
-            vv: s.reset_dv,
-        };
-        let map = reset
+        let map = s
+            .reset()
             .scaled(T::one() - stairs.slope)
             .add(&s.matrix.scaled(stairs.slope));
         let offset = (
@@ -796,8 +791,8 @@ where
     if plant.approach_velocity == ApproachVelocity::Midpoint {
         return None;
     }
-    let plants = plant_step(model, u, (t, q, v), plant)?;
-    let holding = plant_step(
+    let (plants, _) = plant_step(model, u, (t, q, v), plant)?;
+    let (holding, _) = plant_step(
         model,
         u,
         (t, q, v),
@@ -806,24 +801,24 @@ where
     finite((plants.q - holding.q, plants.v - holding.v))
 }
 
-/// One step of the plant `plant` from `(q, v)` at `t`; `None` where its
-/// settings are refused or the step fails.
+/// One step of the plant `plant` from `(q, v)` at `t`, and what the step
+/// did; `None` where its settings are refused or the step fails.
 fn plant_step<M, T, const N: usize, const K: usize>(
     model: &M,
     u: &M::Input,
     (t, q, v): (T, &SVector<T, N>, &SVector<T, N>),
     plant: StepParams<T>,
-) -> Option<State<T, N>>
+) -> Option<(State<T, N>, StepReport<T, K>)>
 where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
     let mut state = State::new(t, *q, *v);
-    MoreauJean::new(plant)
+    let report = MoreauJean::new(plant)
         .ok()?
         .step(model, &mut state, u)
         .ok()?;
-    Some(state)
+    Some((state, report))
 }
 
 /// A plant's error `(Δq, Δv)`, or `None` where it is not finite.
@@ -871,11 +866,7 @@ where
     M: Sensitivities<N, K, Scalar = T>,
 {
     let (q_start, v_start) = flown(model, u, (t, q, v_minus), -phase)?;
-    let mut state = State::new(t - phase, q_start, v_start);
-    let report = MoreauJean::new(plant)
-        .ok()?
-        .step(model, &mut state, u)
-        .ok()?;
+    let (state, report) = plant_step(model, u, (t - phase, &q_start, &v_start), plant)?;
     if !report.impacting().contains(guard) {
         return None;
     }
@@ -899,7 +890,7 @@ where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
-    let state = plant_step(model, u, (t, q, v_minus), plant)?;
+    let (state, _) = plant_step(model, u, (t, q, v_minus), plant)?;
     let (q_exact, v_exact) = flown(model, u, (t, q, v_plus), plant.tau)?;
     finite((state.q - q_exact, state.v - v_exact))
 }

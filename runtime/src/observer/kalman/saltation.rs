@@ -318,6 +318,27 @@ pub struct Saltation<T: RealField + Copy, const N: usize, const K: usize> {
     pub timing: (SVector<T, N>, SVector<T, N>),
 }
 
+impl<T: RealField + Copy, const N: usize, const K: usize> Saltation<T, N, K> {
+    /// `DΔ = [[I, 0], [X, R]]`, the reset's Jacobian: the saltation of the
+    /// same impact at a fixed instant.
+    pub(crate) fn reset(&self) -> Blocks<T, N> {
+        reset_map(&self.reset_dq, &self.reset_dv)
+    }
+}
+
+/// `[[I, 0], [X, R]]` from the reset's blocks `X = ∂v⁺/∂q`, `R = ∂v⁺/∂v⁻`.
+fn reset_map<T: RealField + Copy, const N: usize>(
+    reset_dq: &SMatrix<T, N, N>,
+    reset_dv: &SMatrix<T, N, N>,
+) -> Blocks<T, N> {
+    Blocks {
+        qq: SMatrix::identity(),
+        qv: SMatrix::zeros(),
+        vq: *reset_dq,
+        vv: *reset_dv,
+    }
+}
+
 /// Newton's law on the active set `active` (the constraints that end the
 /// impact with a positive impulse: the LCP's outcome) with the
 /// coefficients `e` (`e_i` as applied: `ê_i` for an elastic impact, `0`
@@ -463,13 +484,7 @@ where
     let base = chol.solve(&(h_lambda - d_m));
     let big_lambda = -w_chol.solve(&(d_j + jac_a * base));
     let reset_dq = base + minv_jt * big_lambda;
-    let reset = Blocks {
-        qq: SMatrix::identity(),
-        qv: SMatrix::zeros(),
-        vq: reset_dq,
-        vv: reset_dv,
-    };
-    let mut matrix = reset;
+    let mut matrix = reset_map(&reset_dq, &reset_dv);
     let accel_minus = -chol.solve(&forces_minus);
     let forces_plus = model.forces(t, q, &v_plus, u);
     finite(&forces_plus, "F")?;
