@@ -113,6 +113,105 @@ pub(super) fn staircase<T: RealField + Copy>(
     }
 }
 
+/// One step the plant may have taken an impact into: the window `j`
+/// steps from the predicted instant's ([`staircase`]'s windows), its
+/// probability, and the mean and variance of the instant's error `δ`
+/// within it (a truncated Gaussian's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Window<T> {
+    pub steps: T,
+    pub probability: T,
+    pub mean: T,
+    pub variance: T,
+}
+
+/// The most steps a split keeps (the filter's state and its
+/// alternatives, module `mixture`): below [`SPLIT_BELOW`] three windows
+/// span at least six deviations, all but 0.3 % of the instant's
+/// probability.
+pub(super) const SPLIT: usize = 3;
+
+/// The instant's deviation, in steps, from which an impact is not split
+/// but takes [`staircase`]'s moments: from half a step on the sawtooth's
+/// first Fourier term is damped to 0.7 % (`exp(−2π² σ²/τ²)`), so the
+/// choice of step is as undecided as the instant itself, which one
+/// Gaussian (the uniform phase) describes.
+const SPLIT_BELOW: f64 = 0.5;
+
+/// The likely windows of an impact whose instant's error `δ ~ N(0, σ²)`
+/// (windows as in [`staircase`]), most probable first, their
+/// probabilities renormalised over those kept; `None` where one window
+/// holds all but `1e-3` of the probability (nothing to split) or where
+/// `σ ≥ τ/2` (many steps: [`staircase`]'s moments instead).
+pub(super) fn likely_windows<T: RealField + Copy>(
+    tau: T,
+    lower: T,
+    sigma: T,
+) -> Option<([Window<T>; SPLIT], usize)> {
+    if !(sigma > tau * nalgebra::convert(1e-9) && sigma < tau * nalgebra::convert(SPLIT_BELOW)) {
+        return None;
+    }
+    let six = nalgebra::convert::<f64, T>(6.0) * sigma;
+    let first = ((-six - lower) / tau).ceil() - T::one();
+    let last = ((six - lower) / tau).ceil() - T::one();
+    let empty = Window {
+        steps: T::zero(),
+        probability: T::zero(),
+        mean: T::zero(),
+        variance: T::zero(),
+    };
+    let mut kept = [empty; SPLIT];
+    let mut j = first;
+    while j <= last {
+        let (a, b) = (
+            (lower + j * tau) / sigma,
+            (lower + (j + T::one()) * tau) / sigma,
+        );
+        let z = normal_cdf(b) - normal_cdf(a);
+        if z > T::zero() {
+            let (fa, fb) = (normal_density(a), normal_density(b));
+            let mean = (fa - fb) / z;
+            let second = T::one() + (a * fa - b * fb) / z;
+            let window = Window {
+                steps: j,
+                probability: z,
+                mean: mean * sigma,
+                variance: (second - mean * mean).max(T::zero()) * sigma * sigma,
+            };
+            // insert by probability
+            let mut at = SPLIT;
+            for (i, k) in kept.iter().enumerate() {
+                if window.probability > k.probability {
+                    at = i;
+                    break;
+                }
+            }
+            if at < SPLIT {
+                for i in (at + 1..SPLIT).rev() {
+                    kept[i] = kept[i - 1];
+                }
+                kept[at] = window;
+            }
+        }
+        j += T::one();
+    }
+    let total = kept.iter().fold(T::zero(), |acc, w| acc + w.probability);
+    let len = kept
+        .iter()
+        .filter(|w| w.probability > total * nalgebra::convert(1e-3))
+        .count();
+    if len < 2 {
+        return None;
+    }
+    let total = kept[..len]
+        .iter()
+        .fold(T::zero(), |acc, w| acc + w.probability);
+    for w in &mut kept[..len] {
+        w.probability /= total;
+    }
+    Some((kept, len))
+}
+
 /// [`staircase`] by the Fourier series of its sawtooth, for `σ ≥ 0.3 τ`:
 /// with `θ = 2π u₀/τ`, `u₀ = −lower`,
 ///
@@ -269,6 +368,32 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn the_likely_windows_are_the_truncated_gaussians() {
+        let tau: f64 = 1e-5;
+        // the instant 0.05 step from an edge, a deviation of 0.1 step:
+        // the window and the next one share the probability
+        let lower = -0.95e-5;
+        let sigma = 1e-6;
+        let (w, len) = likely_windows(tau, lower, sigma).unwrap();
+        assert_eq!(len, 2);
+        assert_eq!((w[0].steps, w[1].steps), (0.0, 1.0));
+        // P(δ > 0.5 µs) = 1 − Φ(0.5) = 0.3085 (tables)
+        assert!((w[1].probability - 0.308_537_5).abs() < 1e-6, "{w:?}");
+        // the mixture of the windows is the Gaussian: mean 0, variance σ²
+        let mean = w[0].probability * w[0].mean + w[1].probability * w[1].mean;
+        let second: f64 = w[..2]
+            .iter()
+            .map(|w| w.probability * (w.variance + w.mean * w.mean))
+            .sum();
+        assert!(
+            mean.abs() < 1e-12 && (second - sigma * sigma).abs() < 1e-15,
+            "{w:?}"
+        );
+        // far from an edge there is nothing to split
+        assert!(likely_windows(tau, -0.5e-5, sigma).is_none());
     }
 
     #[test]

@@ -129,6 +129,12 @@
 //!    gate, `P` is inflated by `yᵀS⁻¹y / N`. The sample is used.
 //! 3. **Update** with `H = [I 0]`: `K = P Hᵀ S⁻¹`, `x ← x + K y` and the
 //!    Joseph form `P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ`, symmetrised.
+//!    Where the filter keeps a plant's likely steps apart
+//!    ([`KalmanParams::plant_step_mixture`], module `mixture`), each is
+//!    reweighed by its own innovation's likelihood and moved by
+//!    `(I − K H)`; the gate takes the smallest of their innovations; the
+//!    estimate is their mean and [`SaltationKalman::covariance`] holds
+//!    their spread ([`KalmanReport::alternatives`]).
 //!
 //! Every congruence `B P Bᵀ` above (flow, saltation, projection, Joseph
 //! update) adds on its diagonal what covers its own rounding
@@ -144,6 +150,7 @@
 
 mod blocks;
 mod grid;
+mod mixture;
 mod propagate;
 mod saltation;
 mod tune;
@@ -165,6 +172,7 @@ use super::{
 };
 use crate::error::DataError;
 use crate::validate;
+use mixture::Mixture;
 use propagate::Propagation;
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
@@ -292,6 +300,18 @@ pub struct KalmanParams<T: RealField + Copy, const N: usize> {
     /// seconds round by more than a thousandth of a 10 µs step, and the
     /// filter stays off the grid there (`tests/kalman.rs`, `runs_in_f32`).
     pub plant_grid: bool,
+    /// Whether, on the [`plant`](KalmanParams::plant)'s grid, the filter
+    /// keeps the steps an impact may have been taken into apart until the
+    /// samples tell them apart (default `true`): where the impact's
+    /// predicted instant lies within half a step of a window's edge, the
+    /// outcomes a step apart differ by a whole step's delay (a few 1e-3
+    /// m/s after a fast impact on a curved surface), and the filter
+    /// carries the likely ones as a sum of Gaussians that share its
+    /// covariance (module `mixture`). `false` takes every impact by the
+    /// staircase's Gaussian moments (module `grid`), one Gaussian, as the
+    /// filter did before the mixture. Without a plant, or off its grid,
+    /// it does nothing.
+    pub plant_step_mixture: bool,
     /// Relative accuracy `ρ_c` of a persistent contact's force, as a
     /// density (units √s): along a piece of sliding or resting contact
     /// with contact acceleration `a_c = M⁻¹Jᵀλ`, white acceleration noise
@@ -423,6 +443,7 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
             impact_delay: T::zero(),
             plant: None,
             plant_grid: true,
+            plant_step_mixture: true,
             contact_noise: nalgebra::convert(1e-6),
             band_sigmas: T::one(),
         }
@@ -481,6 +502,25 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
     #[must_use]
     pub fn with_plant_grid(self, plant_grid: bool) -> Self {
         Self { plant_grid, ..self }
+    }
+
+    /// The same settings with [`KalmanParams::plant_step_mixture`]:
+    /// `false` for one Gaussian over the steps an impact may have been
+    /// taken into.
+    ///
+    /// ```
+    /// use moreau_runtime::KalmanParams;
+    ///
+    /// let p = KalmanParams::<f64, 2>::new(20.0, 1e-4).with_plant_step(1e-5);
+    /// assert!(p.plant_step_mixture);
+    /// assert!(!p.with_plant_step_mixture(false).plant_step_mixture);
+    /// ```
+    #[must_use]
+    pub fn with_plant_step_mixture(self, plant_step_mixture: bool) -> Self {
+        Self {
+            plant_step_mixture,
+            ..self
+        }
     }
 
     /// [`KalmanParams::with_plant_step`] for a plant with other settings
@@ -618,6 +658,12 @@ pub struct KalmanReport<T> {
     /// Predictions made again at a new linearisation point (only the
     /// first update after a start or a restart: module docs, step 1, "Relinearised").
     pub relinearisations: u32,
+    /// The steps a plant may have taken a recent impact into that the
+    /// filter keeps apart beside its state after the update
+    /// ([`KalmanParams::plant_step_mixture`]): while there are any, the
+    /// estimate is a sum of Gaussians, and [`SaltationKalman::covariance`]
+    /// holds the spread of their means.
+    pub alternatives: u32,
 }
 
 impl<T: RealField + Copy> KalmanReport<T> {
@@ -631,6 +677,7 @@ impl<T: RealField + Copy> KalmanReport<T> {
             projections: 0,
             released: 0,
             relinearisations: 0,
+            alternatives: 0,
         }
     }
 
@@ -642,7 +689,7 @@ impl<T: RealField + Copy> KalmanReport<T> {
     ///
     /// let r = KalmanReport { nis: 0.0, log_det: 0.0, outlier: false, inflated: false,
     ///                        saltations: 0, projections: 0, released: 0,
-    ///                        relinearisations: 0 };
+    ///                        relinearisations: 0, alternatives: 0 };
     /// let expected = -0.5 * (2.0 * std::f64::consts::PI).ln();
     /// assert!((r.log_likelihood(1) - expected).abs() < 1e-15);
     /// ```
@@ -735,6 +782,12 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     /// Whether the next update is the first since a start or a restart
     /// (and relinearises: module docs, step 1, "Relinearised").
     fresh: bool,
+    /// The steps a plant may have taken a recent impact into, beside the
+    /// one the state holds (module `mixture`; empty without a plant).
+    mixture: Mixture<T, N>,
+    /// `P` plus the spread of the mixture's means: the covariance of the
+    /// estimate the filter reports.
+    reported: Blocks<T, N>,
 }
 
 impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
@@ -810,6 +863,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             cache: Cache::default(),
             sample: q0,
             fresh: true,
+            mixture: Mixture::empty(),
+            reported: p0,
         })
     }
 
@@ -828,13 +883,17 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         })
     }
 
-    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]).
+    /// The current estimate `(q̂, v̂)` (also [`Observer::estimate`]): the
+    /// mean over the steps a plant may have taken a recent impact into,
+    /// where the filter keeps more than one
+    /// ([`KalmanParams::plant_step_mixture`]).
     #[must_use]
     pub fn estimate(&self) -> Estimate<T, N> {
+        let (dq, dv) = self.mixture.mean();
         Estimate {
             t: self.t,
-            q: self.q,
-            v: self.v,
+            q: self.q + dq,
+            v: self.v + dv,
         }
     }
 
@@ -845,9 +904,11 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         &self.report
     }
 
-    /// The covariance `P` of the estimate.
+    /// The covariance `P` of the estimate (with the spread of the steps a
+    /// plant may have taken a recent impact into, where the filter keeps
+    /// more than one).
     pub fn covariance(&self) -> &Blocks<T, N> {
-        &self.p
+        &self.reported
     }
 
     /// What the last successful update's covariance did (the normalised
@@ -1124,7 +1185,15 @@ where
             .iter()
             .fold(T::zero(), |acc, &d| acc + d.ln())
             * nalgebra::convert(2.0);
-        let (q_new, v_new) = if nis > gate && !kalman.inflated {
+        // (a sample that one of the steps a plant may have taken a recent
+        // impact into explains is no outlier: module `mixture`)
+        let mut mixture = propagation.mixture;
+        let gated = if mixture.is_empty() {
+            nis
+        } else {
+            mixture.least_nis(&y, |x| chol.solve(x))
+        };
+        let (q_new, v_new) = if gated > gate && !kalman.inflated {
             kalman.outlier = true;
             outliers += 1;
             (q_pred, v_pred)
@@ -1134,7 +1203,18 @@ where
             let k_q = chol.solve(&p.qq).transpose();
             let k_v = chol.solve(&p.qv).transpose();
             p = p.joseph_position_update(&k_q, &k_v, &r);
-            (q_pred + k_q * y, v_pred + k_v * y)
+            // each step's own innovation reweighs it, the likeliest
+            // becoming the state (module `mixture`)
+            let (dq, dv) = if mixture.is_empty() {
+                (SVector::zeros(), SVector::zeros())
+            } else {
+                let (dq, dv) = mixture.update(&y, (&k_q, &k_v), |x| chol.solve(x));
+                // those the samples cannot tell from the state join it
+                let ((mq, mv), gained) = mixture.merge_close(&p);
+                p = p.add(&gained);
+                (dq + mq, dv + mv)
+            };
+            (q_pred + k_q * y + dq, v_pred + k_v * y + dv)
         };
         // WRITEBACK: only a finite result replaces the state, its
         // velocity held to C_v (the projection onto a ball that holds the
@@ -1156,6 +1236,13 @@ where
             (self.sample, self.fresh) = (*q, false);
         }
         (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
+        self.mixture = mixture;
+        kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
+        self.reported = if mixture.is_empty() {
+            p
+        } else {
+            p.add(&mixture.spread())
+        };
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
         Ok(Self::estimate(self))
     }
@@ -1260,7 +1347,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             interval.u,
             (self.t, interval.tau),
             &self.params,
-            self.p,
+            (self.p, self.mixture),
         );
         if self.fresh {
             propagation = propagation.relinearised((self.q - q, v0 - w));
@@ -1316,6 +1403,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         let p = Blocks::diagonal(self.params.measurement, SMatrix::identity() * (s * s));
         report.outliers = self.screen.accept();
         (self.t, self.q, self.v, self.p) = (t, q, v, p);
+        (self.mixture, self.reported) = (Mixture::empty(), p);
         (self.sample, self.fresh) = (q, true);
         (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
         Self::estimate(self)
