@@ -42,7 +42,9 @@ pub fn velocity_covariances(
     tau: f64,
     (from, to): (f64, f64),
 ) -> Vec<Matrix2<f64>> {
-    let mut params = KalmanParams::new(20.0, sigma).with_plant_step(tau);
+    let mut params = KalmanParams::new(20.0, sigma)
+        .with_plant_step(tau)
+        .with_plant_step_mixture(false);
     params.accel_noise = SVector::zeros();
     params.contact_noise = 0.0;
     let exact = measure(data, 0.0, 0);
