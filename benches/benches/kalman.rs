@@ -3,7 +3,10 @@
 //! backward finite difference of the samples (the estimators of the noise
 //! sweep's table), in one run, on Example 1 sampled at 1 kHz
 //! with σ = 1e-4: in free flight, with an impact inside the interval, and
-//! sliding. The filter runs with its defaults, told the plant's step
+//! sliding; and, where the filter told the plant's step keeps the steps an
+//! impact may have been taken into apart (`KalmanParams::plant_step_mixture`),
+//! the impact that splits and the next interval without an impact that
+//! carries them. The filter runs with its defaults, told the plant's step
 //! (`KalmanParams::with_plant_step`, which takes one step of the plant
 //! at each impact), and told Siconos's law (`KalmanParams::with_plant`
 //! with `StepParams::siconos`, which also takes two plant steps on each
@@ -59,10 +62,13 @@ fn updates(c: &mut Criterion) {
     let free = 500;
     let impact = (100..data.len()).find(|&k| data[k].2 > 0).unwrap();
     let sliding = 6000;
+    let (split, kept) = kept_apart(&data);
     let mut group = c.benchmark_group("kalman/parabola");
     for (label, k) in [
         ("free flight", free),
         ("impact", impact),
+        ("impact, steps kept apart", split),
+        ("free flight, steps kept apart", kept),
         ("sliding", sliding),
     ] {
         let kalman_params = KalmanParams::new(20.0, 1e-4);
@@ -108,11 +114,15 @@ fn updates(c: &mut Criterion) {
         probe.update(&model, t, &q, &u).unwrap();
         let mut probe_38 = reduced;
         probe_38.update(&model, t, &q, &u).unwrap();
+        let mut probe_stepped = stepped;
+        probe_stepped.update(&model, t, &q, &u).unwrap();
         eprintln!(
-            "{label} (interval ending at {t:.3} s): filter impacts {}, saltations {}, contacts {:?}; (38) impacts {}, contacts {:?}",
+            "{label} (interval ending at {t:.3} s): filter impacts {}, saltations {}, contacts {:?}; told the plant's step, steps kept apart before {} and after {}; (38) impacts {}, contacts {:?}",
             probe.report().impacts,
             probe.kalman_report().saltations,
             probe.report().contacts,
+            stepped.kalman_report().alternatives,
+            probe_stepped.kalman_report().alternatives,
             probe_38.report().impacts,
             probe_38.report().contacts
         );
@@ -168,6 +178,34 @@ fn updates(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// The intervals after 0.1 s where the filter told the plant's step
+/// first splits an impact into the steps it may have been taken into (an
+/// impact inside, none kept apart before it, some after), and then first
+/// carries them through an interval without an impact
+/// (`KalmanParams::plant_step_mixture`).
+fn kept_apart(data: &[(f64, Vector2<f64>, usize)]) -> (usize, usize) {
+    let model = Parabola::<f64>::default();
+    let u = SVector::zeros();
+    let params = KalmanParams::new(20.0, 1e-4).with_plant_step(1e-5);
+    let mut f =
+        SaltationKalman::<f64, 2, 2>::new(params, 0.0, data[0].1, Vector2::zeros()).unwrap();
+    let mut split = None;
+    let mut before = 0;
+    for (k, (t, q, impacts)) in data.iter().enumerate().skip(1) {
+        f.update(&model, *t, q, &u).unwrap();
+        let now = f.kalman_report().alternatives;
+        if k > 100 {
+            match split {
+                None if *impacts > 0 && before == 0 && now > 0 => split = Some(k),
+                Some(s) if *impacts == 0 && before > 0 && now > 0 => return (s, k),
+                _ => {}
+            }
+        }
+        before = now;
+    }
+    panic!("no impact split on the record")
 }
 
 /// The backward difference of the samples, `(q_k − q_{k−1}) / (t_k −
