@@ -220,8 +220,9 @@ where
     /// The steps a plant may have taken an impact into, beside the
     /// predicted one (module `mixture`): offsets carried as `offset` is.
     pub mixture: Mixture<T, N>,
-    /// Whether an impact may still split the prediction (none split yet
-    /// in this interval).
+    /// Whether an impact may still split the prediction
+    /// ([`KalmanParams::plant_step_mixture`] set, and none split yet in
+    /// this interval).
     may_split: bool,
     /// `Φ P_k`, the covariance of the predicted end with the start, when
     /// the filter relinearises (`None` otherwise: no work).
@@ -522,6 +523,8 @@ where
             guard,
         )?;
         let reset = s.reset();
+        // the instant's error per unit of the state's: `δ = g·δq`
+        let g = row.transpose() / -rate;
         let sigma2 = sigma_state * sigma_state + self.machine_timing * self.machine_timing;
         if self.may_split
             && let Some((windows, split)) = likely_windows(tau, lower, sigma2.sqrt())
@@ -532,7 +535,6 @@ where
             // reset's Jacobian (inside a window the plant's outcome does
             // not move with the instant), `j τ d` apart; one covariance,
             // conditioned on the windows' mean variance
-            let g = row.transpose() / -rate;
             let (pg_q, pg_v) = (self.p.qq * g, self.p.vq * g);
             let moved = |m: T| reset.apply(&(pg_q * (m / sigma2)), &(pg_v * (m / sigma2)));
             let best = windows[0];
@@ -580,12 +582,11 @@ where
             error.0 + s.timing.0 * stairs.mean,
             error.1 + s.timing.1 * stairs.mean,
         );
-        // the steps an earlier impact may have been taken into: each its
-        // own instant, `g·Δq_a` from the state's, and so its own window
-        // and its own staircase mean (the state's map, linear in `κ`,
-        // would carry an alternative one step off across an edge by
-        // nothing where `σ ≪ τ`)
-        let g = row.transpose() / -rate;
+        // the steps an earlier impact may have been taken into: each has
+        // its own instant, `g·Δq_a` from the state's, and so its own window
+        // and its own staircase mean (through the state's map, linear with
+        // the state's `κ ≈ 0` where `σ ≪ τ`, a step whose instant lies
+        // across an edge would land a whole step off)
         let mut carried = [(SVector::zeros(), SVector::zeros()); ALTERNATIVES];
         for (a, slot) in carried.iter_mut().enumerate().take(self.mixture.len()) {
             let (dq, dv) = self.mixture.offset(a);
@@ -901,6 +902,8 @@ struct OnGrid<T: RealField + Copy, const N: usize> {
     /// predicted one and their log-weights relative to it (the first
     /// `split`).
     alternatives: [(Offset<T, N>, T); SPLIT - 1],
+    /// How many of `alternatives` there are (0: the impact does not
+    /// split).
     split: usize,
     /// The mixture's alternatives after the impact, each taken into its
     /// own step (where the impact does not split).
