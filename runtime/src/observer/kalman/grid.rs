@@ -85,32 +85,67 @@ pub(super) fn staircase<T: RealField + Copy>(
     if sigma >= tau * nalgebra::convert(0.3) {
         return fourier(tau, lower, sigma, sigma_machine);
     }
-    // the windows that meet `[−6σ, 6σ]`
-    let six = nalgebra::convert::<f64, T>(6.0) * sigma;
-    let first = ((-six - lower) / tau).ceil() - T::one();
-    let last = ((six - lower) / tau).ceil() - T::one();
     let mut mean = T::zero();
     let mut square = T::zero();
-    let mut j = first;
-    let mut cdf_below = normal_cdf((lower + j * tau) / sigma);
-    let mut density = normal_density((lower + j * tau) / sigma);
-    while j <= last {
-        let upper = (lower + (j + T::one()) * tau) / sigma;
-        let cdf_above = normal_cdf(upper);
-        let p = cdf_above - cdf_below;
-        mean += j * p;
-        square += j * j * p;
-        density += normal_density(upper);
-        cdf_below = cdf_above;
-        j += T::one();
+    // the density at every edge, the lowest one's first
+    let mut density: Option<T> = None;
+    for w in windows(tau, lower, sigma) {
+        let j = w.steps;
+        mean += j * w.probability;
+        square += j * j * w.probability;
+        density = Some(density.unwrap_or(w.density_lower) + w.density_upper);
     }
-    let slope = tau * density / sigma;
+    let slope = tau * density.unwrap_or(T::zero()) / sigma;
     let variance = tau * tau * (square - mean * mean).max(T::zero());
     Staircase {
         mean: tau * mean,
         slope,
         residual: (variance - slope * slope * sigma_state * sigma_state).max(T::zero()),
     }
+}
+
+/// One window `(lower + jτ, lower + (j + 1)τ]` of the instant's error
+/// `δ ~ N(0, σ²)` ([`windows`]): its edges in deviations, its probability
+/// and the density at each edge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Edges<T> {
+    steps: T,
+    lower: T,
+    upper: T,
+    probability: T,
+    density_lower: T,
+    density_upper: T,
+}
+
+/// The windows of [`staircase`] that meet `[−6σ, 6σ]`, lowest first; each
+/// edge's distribution and density is evaluated once, the upper edge's
+/// serving as the next window's lower.
+fn windows<T: RealField + Copy>(tau: T, lower: T, sigma: T) -> impl Iterator<Item = Edges<T>> {
+    let six = nalgebra::convert::<f64, T>(6.0) * sigma;
+    let first = ((-six - lower) / tau).ceil() - T::one();
+    let last = ((six - lower) / tau).ceil() - T::one();
+    let edge = move |j: T| {
+        let x = (lower + j * tau) / sigma;
+        (x, normal_cdf(x), normal_density(x))
+    };
+    let mut j = first;
+    let mut below = edge(first);
+    core::iter::from_fn(move || {
+        if j > last {
+            return None;
+        }
+        let above = edge(j + T::one());
+        let w = Edges {
+            steps: j,
+            lower: below.0,
+            upper: above.0,
+            probability: above.1 - below.1,
+            density_lower: below.2,
+            density_upper: above.2,
+        };
+        (j, below) = (j + T::one(), above);
+        Some(w)
+    })
 }
 
 /// One step the plant may have taken an impact into: the window `j`
@@ -151,9 +186,6 @@ pub(super) fn likely_windows<T: RealField + Copy>(
     if !(sigma > tau * nalgebra::convert(1e-9) && sigma < tau * nalgebra::convert(SPLIT_BELOW)) {
         return None;
     }
-    let six = nalgebra::convert::<f64, T>(6.0) * sigma;
-    let first = ((-six - lower) / tau).ceil() - T::one();
-    let last = ((six - lower) / tau).ceil() - T::one();
     let empty = Window {
         steps: T::zero(),
         probability: T::zero(),
@@ -161,19 +193,15 @@ pub(super) fn likely_windows<T: RealField + Copy>(
         variance: T::zero(),
     };
     let mut kept = [empty; SPLIT];
-    let mut j = first;
-    while j <= last {
-        let (a, b) = (
-            (lower + j * tau) / sigma,
-            (lower + (j + T::one()) * tau) / sigma,
-        );
-        let z = normal_cdf(b) - normal_cdf(a);
+    for edges in windows(tau, lower, sigma) {
+        let z = edges.probability;
         if z > T::zero() {
-            let (fa, fb) = (normal_density(a), normal_density(b));
+            let (a, b) = (edges.lower, edges.upper);
+            let (fa, fb) = (edges.density_lower, edges.density_upper);
             let mean = (fa - fb) / z;
             let second = T::one() + (a * fa - b * fb) / z;
             let window = Window {
-                steps: j,
+                steps: edges.steps,
                 probability: z,
                 mean: mean * sigma,
                 variance: (second - mean * mean).max(T::zero()) * sigma * sigma,
@@ -193,7 +221,6 @@ pub(super) fn likely_windows<T: RealField + Copy>(
                 kept[at] = window;
             }
         }
-        j += T::one();
     }
     let total = kept.iter().fold(T::zero(), |acc, w| acc + w.probability);
     let len = kept

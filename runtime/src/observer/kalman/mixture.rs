@@ -63,6 +63,11 @@ use super::Blocks;
 /// An offset `(Δq, Δv)` of a step's mean from the filter's state.
 pub type Offset<T, const N: usize> = (SVector<T, N>, SVector<T, N>);
 
+/// No offset: the state itself, and an empty slot.
+pub fn no_offset<T: RealField + Copy, const N: usize>() -> Offset<T, N> {
+    (SVector::zeros(), SVector::zeros())
+}
+
 /// The most alternatives kept beside the filter's own state.
 pub const ALTERNATIVES: usize = 2;
 
@@ -90,7 +95,7 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
     /// No alternative: the filter's state alone.
     pub fn empty() -> Self {
         Self {
-            offsets: [(SVector::zeros(), SVector::zeros()); ALTERNATIVES],
+            offsets: [no_offset(); ALTERNATIVES],
             log_weights: [T::zero(); ALTERNATIVES],
             len: 0,
         }
@@ -209,7 +214,7 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
     /// `P + w/(1 + w)² Δ Δᵀ` for an alternative of relative weight `w`).
     /// Returns the state's move and what its covariance gains.
     pub fn merge_close(&mut self, p: &Blocks<T, N>) -> (Offset<T, N>, Blocks<T, N>) {
-        let mut moved = (SVector::zeros(), SVector::zeros());
+        let mut moved = no_offset();
         let mut gained = Blocks::outer(&SVector::zeros(), &SVector::zeros());
         let mut a = 0;
         while a < self.len {
@@ -241,7 +246,7 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
     /// more likely than the state, and drops the unlikely; returns the
     /// state's move.
     fn rebase(&mut self) -> Offset<T, N> {
-        let mut moved = (SVector::zeros(), SVector::zeros());
+        let mut moved = no_offset();
         let best = (0..self.len)
             .filter(|&a| self.log_weights[a] > T::zero())
             .max_by(|&a, &b| {

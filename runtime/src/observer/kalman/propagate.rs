@@ -169,7 +169,7 @@ use crate::validate::{self, factor_mass};
 use super::super::ObserverError;
 use super::super::interval::{Flight, Jump, Law, Tracer, fastest_approach, saturate};
 use super::grid::{SPLIT, likely_windows, staircase};
-use super::mixture::{ALTERNATIVES, Mixture, Offset};
+use super::mixture::{ALTERNATIVES, Mixture, Offset, no_offset};
 use super::saltation::{
     Saltation, constrained_flow_jacobian, flow_jacobian, flow_transition, project_onto_contact,
     saltation,
@@ -546,7 +546,7 @@ where
             let along = |steps: T| (s.timing.0 * (steps * tau), s.timing.1 * (steps * tau));
             let (own_q, own_v) = moved(best.mean);
             let (own_dq, own_dv) = along(best.steps);
-            let mut alternatives = [((SVector::zeros(), SVector::zeros()), T::zero()); SPLIT - 1];
+            let mut alternatives = [(no_offset(), T::zero()); SPLIT - 1];
             for (slot, w) in alternatives.iter_mut().zip(&windows[1..split]) {
                 let (mq, mv) = moved(w.mean - best.mean);
                 let (dq, dv) = along(w.steps - best.steps);
@@ -567,10 +567,11 @@ where
                     offset: (error.0 + own_q + own_dq, error.1 + own_v + own_dv),
                     map: reset,
                     residual: T::zero(),
-                    conditioned: Some(conditioned),
-                    alternatives,
-                    split: split - 1,
-                    carried: [(SVector::zeros(), SVector::zeros()); ALTERNATIVES],
+                    steps: Steps::Split {
+                        conditioned,
+                        alternatives,
+                        len: split - 1,
+                    },
                 });
             }
         }
@@ -587,7 +588,7 @@ where
         // and its own staircase mean (through the state's map, linear with
         // the state's `κ ≈ 0` where `σ ≪ τ`, a step whose instant lies
         // across an edge would land a whole step off)
-        let mut carried = [(SVector::zeros(), SVector::zeros()); ALTERNATIVES];
+        let mut carried = [no_offset(); ALTERNATIVES];
         for (a, slot) in carried.iter_mut().enumerate().take(self.mixture.len()) {
             let (dq, dv) = self.mixture.offset(a);
             let shifted = lower - g.dot(&dq);
@@ -601,10 +602,7 @@ where
             offset,
             map,
             residual: stairs.residual,
-            conditioned: None,
-            alternatives: [((SVector::zeros(), SVector::zeros()), T::zero()); SPLIT - 1],
-            split: 0,
-            carried,
+            steps: Steps::Carried(carried),
         })
     }
 
@@ -820,7 +818,10 @@ where
             (Some(plant), Some(g)) => self.on_grid_impact(jump, (&w, &s), g, plant),
             _ => None,
         };
-        if on_grid.as_ref().is_some_and(|g| g.split > 0) && !self.mixture.is_empty() {
+        let splits = on_grid
+            .as_ref()
+            .is_some_and(|g| matches!(g.steps, Steps::Split { .. }));
+        if splits && !self.mixture.is_empty() {
             // the steps of an earlier impact, still undecided, are
             // merged into one Gaussian (their mean and spread), and
             // this impact takes the staircase's moments: inside an
@@ -840,25 +841,35 @@ where
             ),
             None => (s.matrix, self.impact_noise(&s, timed, jump.p, &w)?),
         };
-        let prior = on_grid
-            .as_ref()
-            .and_then(|g| g.conditioned)
-            .unwrap_or(self.p);
+        let prior = match &on_grid {
+            Some(OnGrid {
+                steps: Steps::Split { conditioned, .. },
+                ..
+            }) => *conditioned,
+            _ => self.p,
+        };
         self.p = map.congruence_covered(&prior).add(&noise).symmetrized();
         self.carry_offset(&map);
         if let Some(on_grid) = on_grid {
-            if on_grid.split == 0 {
-                for a in 0..self.mixture.len() {
-                    self.mixture.set_offset(a, on_grid.carried[a]);
-                }
-            }
             self.offset.0 += on_grid.offset.0;
             self.offset.1 += on_grid.offset.1;
-            // the other steps the plant may have taken it into, after the
-            // impact (module `mixture`)
-            for &(offset, log_weight) in &on_grid.alternatives[..on_grid.split] {
-                self.mixture.push(offset, log_weight);
-                self.may_split = false;
+            match on_grid.steps {
+                // the other steps the plant may have taken it into, after
+                // the impact (module `mixture`)
+                Steps::Split {
+                    alternatives, len, ..
+                } => {
+                    for &(offset, log_weight) in &alternatives[..len] {
+                        self.mixture.push(offset, log_weight);
+                    }
+                    self.may_split = false;
+                }
+                // an earlier impact's kept steps, each in its own window
+                Steps::Carried(carried) => {
+                    for (a, &offset) in carried.iter().enumerate().take(self.mixture.len()) {
+                        self.mixture.set_offset(a, offset);
+                    }
+                }
             }
         } else if timed {
             // a mean delay moves the state along `d`; a plant's step, by
@@ -895,19 +906,25 @@ struct OnGrid<T: RealField + Copy, const N: usize> {
     map: Blocks<T, N>,
     /// The delay's variance the state does not explain, along `d`.
     residual: T,
-    /// The covariance before the impact conditioned on the predicted
-    /// step, where the impact splits the prediction.
-    conditioned: Option<Blocks<T, N>>,
-    /// The other likely steps: offsets after the impact from the
-    /// predicted one and their log-weights relative to it (the first
-    /// `split`).
-    alternatives: [(Offset<T, N>, T); SPLIT - 1],
-    /// How many of `alternatives` there are (0: the impact does not
-    /// split).
-    split: usize,
-    /// The mixture's alternatives after the impact, each taken into its
-    /// own step (where the impact does not split).
-    carried: [Offset<T, N>; ALTERNATIVES],
+    /// What becomes of the steps the plant may have taken impacts into.
+    steps: Steps<T, N>,
+}
+
+/// The steps an impact on the plant's grid keeps apart (module
+/// `mixture`).
+enum Steps<T: RealField + Copy, const N: usize> {
+    /// The impact splits the prediction: the covariance before it
+    /// conditioned on the predicted step, and the other likely steps'
+    /// offsets after it from the predicted one with their log-weights
+    /// relative to it (the first `len`).
+    Split {
+        conditioned: Blocks<T, N>,
+        alternatives: [(Offset<T, N>, T); SPLIT - 1],
+        len: usize,
+    },
+    /// It does not: the steps an earlier impact was kept apart in, each
+    /// taken into its own window (the first [`Mixture::len`]).
+    Carried([Offset<T, N>; ALTERNATIVES]),
 }
 
 /// The drag of a plant's law along a slide: one step of the plant
