@@ -1,6 +1,10 @@
 //! Fuzz suite (issue 9): random, extreme and non-finite inputs mixed into
 //! valid streams for the plant stepper, both observers and the saltation
-//! Kalman filter, on every shipped model. Asserted, for every input:
+//! Kalman filter, on every shipped model. The filter runs twice: with its
+//! defaults on the plant's exact samples, and told the plant (its step,
+//! on its grid) on the samples with noise `σ = 1e-4`, where an impact's
+//! likely steps are kept apart as a sum of Gaussians (the count of
+//! updates that held more than one is printed). Asserted, for every input:
 //!
 //! - no panic (the test would fail), and no non-finite output: every `Ok`
 //!   state or estimate is finite, every estimate within `C_v`;
@@ -23,6 +27,9 @@ use moreau::{
 };
 use moreau_models::{Arm3, Billiard, DoublePendulum, Parabola, ThreeBalls};
 use nalgebra::SVector;
+
+/// The reference plant's step; it keeps every tenth state (1 kHz).
+const PLANT_STEP: f64 = 1e-4;
 
 /// SplitMix64: a small, deterministic generator (no dependency).
 struct Rng(u64);
@@ -73,6 +80,11 @@ impl Rng {
     /// A NaN or an infinity.
     fn non_finite(&mut self) -> f64 {
         [f64::NAN, f64::INFINITY, f64::NEG_INFINITY][self.below(3)]
+    }
+    /// Standard normal (Box–Muller).
+    fn normal(&mut self) -> f64 {
+        let u = 1.0 - self.unit();
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * self.unit()).cos()
     }
 }
 
@@ -198,7 +210,7 @@ fn reference<M, const N: usize, const K: usize, const NU: usize>(
 where
     M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>>,
 {
-    let stepper = MoreauJean::new(StepParams::new(1e-4)).unwrap();
+    let stepper = MoreauJean::new(StepParams::new(PLANT_STEP)).unwrap();
     let mut state = State::new(0.0, start.0, start.1);
     let u = SVector::zeros();
     let (mut samples, mut speed) = (Vec::new(), 0.0_f64);
@@ -220,7 +232,8 @@ fn report_bits<const N: usize, const K: usize>(r: &UpdateReport<f64, N, K>) -> S
     format!("{r:?}")
 }
 
-/// One observer against its twin on a stream with bad samples mixed in.
+/// One observer against its twin on a stream with bad samples mixed in;
+/// `each` sees the observer after every valid sample.
 fn fuzz_observer<M, O, const N: usize, const K: usize, const NU: usize>(
     name: &str,
     model: &M,
@@ -228,6 +241,7 @@ fn fuzz_observer<M, O, const N: usize, const K: usize, const NU: usize>(
     samples: &[(f64, SVector<f64, N>)],
     velocity_bound: f64,
     rng: &mut Rng,
+    mut each: impl FnMut(&O),
 ) -> [usize; 3]
 where
     M: Model<N, K, Scalar = f64, Input = SVector<f64, NU>> + Clone,
@@ -304,6 +318,7 @@ where
                 // recovery in 0 samples: as if no bad sample had come
                 assert_eq!(state_bits(a), state_bits(b), "{name} at t = {t}");
                 assert_eq!(report_bits(observer.report()), report_bits(twin.report()));
+                each(&observer);
             }
             _ => panic!("{name}: a valid sample at t = {t} gave {a:?} (twin {b:?})"),
         }
@@ -328,14 +343,45 @@ fn fuzz_model<M, const N: usize, const K: usize, const NU: usize>(
     let reduced = ReducedOrder::<f64, N, K>::new(params, t0, q0, v0).unwrap();
     let gains = FullOrderGains::scalar(5.0, 25.0);
     let full = FullOrder::<f64, N, K>::new(params, gains, t0, q0, v0).unwrap();
-    let r = fuzz_observer::<_, _, N, K, NU>(name, &model, reduced, &samples, velocity_bound, rng);
-    let f = fuzz_observer::<_, _, N, K, NU>(name, &model, full, &samples, velocity_bound, rng);
+    let r = fuzz_observer::<_, _, N, K, NU>(
+        name,
+        &model,
+        reduced,
+        &samples,
+        velocity_bound,
+        rng,
+        |_| (),
+    );
+    let f =
+        fuzz_observer::<_, _, N, K, NU>(name, &model, full, &samples, velocity_bound, rng, |_| ());
     let kalman =
         SaltationKalman::<f64, N, K>::new(KalmanParams::new(velocity_bound, 1e-4), t0, q0, v0)
             .unwrap();
-    let k = fuzz_observer::<_, _, N, K, NU>(name, &model, kalman, &samples, velocity_bound, rng);
+    let k = fuzz_observer::<_, _, N, K, NU>(
+        name,
+        &model,
+        kalman,
+        &samples,
+        velocity_bound,
+        rng,
+        |_| (),
+    );
+    // the filter told the plant (its step and grid: the samples are every
+    // tenth state), on noisy samples: the path that keeps an impact's
+    // likely steps apart (`plant_step_mixture`)
+    let sigma = 1e-4;
+    let noisy: Vec<_> = samples
+        .iter()
+        .map(|&(t, q)| (t, q + SVector::from_fn(|_, _| sigma * rng.normal())))
+        .collect();
+    let told = KalmanParams::new(velocity_bound, sigma).with_plant(StepParams::new(PLANT_STEP));
+    let told = SaltationKalman::<f64, N, K>::new(told, t0, noisy[0].1, v0).unwrap();
+    let mut kept = 0;
+    let each =
+        |f: &SaltationKalman<f64, N, K>| kept += usize::from(f.kalman_report().alternatives > 0);
+    let p = fuzz_observer::<_, _, N, K, NU>(name, &model, told, &noisy, velocity_bound, rng, each);
     eprintln!(
-        "{name}: plant {refused} refused, {extreme_ok} extreme accepted; {} samples, reduced {} outliers / {} refused / {} long gaps, full {} / {} / {}, Kalman {} / {} / {}",
+        "{name}: plant {refused} refused, {extreme_ok} extreme accepted; {} samples, reduced {} outliers / {} refused / {} long gaps, full {} / {} / {}, Kalman {} / {} / {}, told the plant {} / {} / {} ({kept} updates with steps kept apart)",
         samples.len(),
         r[0],
         r[1],
@@ -345,9 +391,12 @@ fn fuzz_model<M, const N: usize, const K: usize, const NU: usize>(
         f[2],
         k[0],
         k[1],
-        k[2]
+        k[2],
+        p[0],
+        p[1],
+        p[2],
     );
-    assert!(r[0] > 0 && f[0] > 0 && k[0] > 0 && refused > 0);
+    assert!(r[0] > 0 && f[0] > 0 && k[0] > 0 && p[0] > 0 && refused > 0);
 }
 
 #[test]
