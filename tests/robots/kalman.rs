@@ -297,7 +297,7 @@ fn the_filter_follows_a_ur5_onto_and_off_a_table() {
 /// exact impact), the same runs again: asserted, the velocity NEES median
 /// within 1.5 times the χ² median and the median error no larger than
 /// with the defaults, on every run. Measured: NEES medians 4.3 to 6.4 on
-/// the Panda (χ² median 6.35) and 7.8 to 8.3 on Go1 (11.3); median
+/// the Panda (χ² median 6.35) and 8.1 to 8.5 on Go1 (11.3); median
 /// errors 1.2e-4 to 3.0e-4 on the Panda and 1.1e-4 to 1.9e-4 on Go1 (the
 /// filter keeps the plant's likely steps apart at some of Go1's impacts,
 /// `KalmanParams::plant_step_mixture`; as one Gaussian its NEES medians

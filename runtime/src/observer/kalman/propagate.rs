@@ -101,7 +101,7 @@
 //! 33 with the step below. Where the predicted instant is known to within
 //! half a step and lies near a window's edge, the likely steps are kept
 //! apart instead, a sum of Gaussians until the samples tell them apart
-//! (module `mixture`, [`KalmanParams::plant_step_mixture`]): 43 of the 48.
+//! (module `mixture`, [`KalmanParams::plant_step_mixture`]): 42 of the 48.
 //! A later impact takes each kept step into its own window (its instant is
 //! its own, `g·Δq` from the state's), not through the state's map, which
 //! is linear in `κ` and, where `σ ≪ τ`, would leave a step that crosses an
