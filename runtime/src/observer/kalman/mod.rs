@@ -634,8 +634,11 @@ impl<T: RealField + Copy, const N: usize> KalmanParams<T, N> {
 }
 
 /// What the last update of a [`SaltationKalman`] did, beyond the
-/// observers' [`UpdateReport`].
+/// observers' [`UpdateReport`]. Read from
+/// [`SaltationKalman::kalman_report`]; it is `#[non_exhaustive]`, so a
+/// field added later (as `alternatives` was) breaks no caller.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct KalmanReport<T> {
     /// The normalised innovation squared `yᵀS⁻¹y`, `χ²_N` distributed when
     /// the noise model is true.
@@ -685,13 +688,18 @@ impl<T: RealField + Copy> KalmanReport<T> {
     /// `−½ (yᵀS⁻¹y + ln det S + N ln 2π)`, for `N` coordinates.
     ///
     /// ```
-    /// use moreau_runtime::KalmanReport;
+    /// use moreau_runtime::{KalmanParams, SaltationKalman};
+    /// use nalgebra::Vector1;
     ///
-    /// let r = KalmanReport { nis: 0.0, log_det: 0.0, outlier: false, inflated: false,
-    ///                        saltations: 0, projections: 0, released: 0,
-    ///                        relinearisations: 0, alternatives: 0 };
+    /// // before any sample: yᵀS⁻¹y = 0 and ln det S = 0
+    /// let params = KalmanParams::<f64, 1>::new(1.0, 1e-3);
+    /// let filter =
+    ///     SaltationKalman::<f64, 1, 1>::new(params, 0.0, Vector1::new(1.0), Vector1::zeros())?;
+    /// let r = filter.kalman_report();
+    /// assert_eq!((r.nis, r.log_det), (0.0, 0.0));
     /// let expected = -0.5 * (2.0 * std::f64::consts::PI).ln();
     /// assert!((r.log_likelihood(1) - expected).abs() < 1e-15);
+    /// # Ok::<(), moreau_runtime::ObserverError<f64>>(())
     /// ```
     pub fn log_likelihood(&self, n: usize) -> T {
         let two_pi: T = nalgebra::convert(2.0 * core::f64::consts::PI);
