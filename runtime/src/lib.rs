@@ -28,8 +28,9 @@ pub use interval::{Interval, LIBM_ULPS, next_down, next_up};
 pub use lcp::{IndexSet, IndexSetIter, Lcp, LcpError, LcpSolution, lcp_residual, solve_lcp};
 pub use model::{Linearization, Model, ModelInfo, Sensitivities, Structure, Terms};
 pub use observer::{
-    Blocks, KalmanParams, KalmanReport, NoiseFactors, Saltation, SaltationKalman, Tuning,
-    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+    Blocks, KalmanParams, KalmanReport, NoiseFactors, Picked, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, pick_by_likelihood, saltation, transition,
+    tune_process_noise,
 };
 #[cfg(feature = "std")]
 pub use observer::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};

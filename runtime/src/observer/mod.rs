@@ -364,8 +364,9 @@ pub use full_order::{FullOrder, FullOrderGains};
 pub use gains::{Budget, CertifiedBounds, CertifiedConstant, CertifyError};
 pub use gains::{Design, GainRegion, ModelBounds};
 pub use kalman::{
-    Blocks, KalmanParams, KalmanReport, NoiseFactors, Saltation, SaltationKalman, Tuning,
-    constrained_flow_jacobian, flow_jacobian, saltation, transition, tune_process_noise,
+    Blocks, KalmanParams, KalmanReport, NoiseFactors, Picked, Saltation, SaltationKalman, Tuning,
+    constrained_flow_jacobian, flow_jacobian, pick_by_likelihood, saltation, transition,
+    tune_process_noise,
 };
 pub use params::{Discretization, ObserverParams};
 pub use reduced_order::ReducedOrder;

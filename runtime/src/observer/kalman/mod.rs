@@ -157,7 +157,7 @@ mod tune;
 
 pub use blocks::Blocks;
 pub use saltation::{Saltation, constrained_flow_jacobian, flow_jacobian, saltation, transition};
-pub use tune::{NoiseFactors, Tuning, tune_process_noise};
+pub use tune::{NoiseFactors, Picked, Tuning, pick_by_likelihood, tune_process_noise};
 
 use nalgebra::{RealField, SMatrix, SVector};
 
