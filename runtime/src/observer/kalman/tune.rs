@@ -61,8 +61,10 @@ impl<T: RealField + Copy> NoiseFactors<T> {
     }
 }
 
-/// The outcome of [`tune_process_noise`].
+/// The outcome of [`tune_process_noise`] (`#[non_exhaustive]`: read, not
+/// built, so a field added later breaks no caller).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct Tuning<T: RealField + Copy, const N: usize> {
     /// The settings with the chosen process noise.
     pub params: KalmanParams<T, N>,
@@ -245,8 +247,10 @@ where
     })
 }
 
-/// The outcome of [`pick_by_likelihood`].
+/// The outcome of [`pick_by_likelihood`] (`#[non_exhaustive]`, as
+/// [`Tuning`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct Picked<T: RealField + Copy, const N: usize> {
     /// The index of the likeliest of the candidates.
     pub index: usize,
