@@ -2910,7 +2910,9 @@ fn exact_starts(seed: u64, count: usize) -> Vec<(Start, Reference<2>)> {
 /// more than a nat (measured 2.4 to 16 and 103 to 1129 nats); on the
 /// first six, samples taken halfway between the plant's steps (its
 /// states there interpolated, every 100 steps) pick its step off the
-/// grid (measured 26 to 44 nats); on the
+/// grid (measured 26 to 44 nats); the first start's record with two
+/// samples moved by 1 m still picks the step on the grid (the filters
+/// refuse those samples as impossible, and the sum skips them); on the
 /// six exact event-driven runs of [`exact_starts`] (no plant: Example 1
 /// solved in closed form), no candidate is likelier than no plant by a
 /// nat or more (measured: no plant picked on five, by 3.9 to 25 nats;
@@ -2939,9 +2941,14 @@ fn the_likelihood_picks_the_plant_that_made_the_samples() {
         ),
     ];
     let params = candidates.map(|(_, p)| p);
-    // the pick among all the candidates, and the log-likelihood of no plant
-    let pick = |data: &Reference<2>, seed: u64| {
-        let measured = measure(data, sigma, seed);
+    // the pick among all the candidates, and the log-likelihood of no
+    // plant; with `glitches`, samples moved by 1 m, which every filter
+    // refuses as impossible and the sum skips
+    let pick_with = |data: &Reference<2>, seed: u64, glitches: &[usize]| {
+        let mut measured = measure(data, sigma, seed);
+        for &k in glitches {
+            measured[k][1] += 1.0;
+        }
         let t: Vec<f64> = data.samples.iter().map(|s| s.t).collect();
         let v0 = Vector2::zeros();
         let among = |params: &[KalmanParams<f64, 2>]| {
@@ -2949,6 +2956,7 @@ fn the_likelihood_picks_the_plant_that_made_the_samples() {
         };
         (among(&params), among(&params[..1]).log_likelihood)
     };
+    let pick = |data: &Reference<2>, seed: u64| pick_with(data, seed, &[]);
     let mut runs = Vec::new();
     for (n, start) in random_example_1_starts(555, 12).into_iter().enumerate() {
         let plant = reference(&model, start, 1e-5, 100, 10.0, &u);
@@ -2966,6 +2974,17 @@ fn the_likelihood_picks_the_plant_that_made_the_samples() {
             Some(5),
         ));
     }
+    // the first start's record again, with two glitches
+    let plant = reference(
+        &model,
+        random_example_1_starts(555, 1)[0],
+        1e-5,
+        100,
+        10.0,
+        &u,
+    );
+    let glitched = pick_with(&plant, 100, &[3000, 7000]);
+    runs.push(("the crate's plant with two glitches", 0, glitched, Some(2)));
     for (n, start) in random_example_1_starts(555, 6).into_iter().enumerate() {
         // every state of the plant, then every hundredth interval's middle
         let fine = reference(&model, start, 1e-5, 1, 10.0, &u);
