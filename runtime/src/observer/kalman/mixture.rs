@@ -43,10 +43,10 @@
 //! to one side take its weight under a hundredth, and dropped, it took
 //! the covariance's room for it along. On Example 1's start (seed 1234,
 //! start 2), noise seed 1019, the right step of an impact at 5.5 m/s was
-//! dropped three samples after it; the estimate was 1.3e-3 m/s off with
-//! a velocity NEES of 570, and 1.5e-4 off (NEES 300) half a second later.
+//! dropped three samples after it; the estimate was 1.4e-3 m/s off with
+//! a velocity NEES of 570, and 1.6e-4 off (NEES 300) half a second later.
 //! Joined, it leaves `w/(1 + w)² Δ Δᵀ` in `P` (a NEES of 93 there, not
-//! 570), and the samples after it move the estimate back: 5.7e-5 m/s off
+//! 570), and the samples after it move the estimate back: 7.8e-5 m/s off
 //! 250 ms later. Over 20 noise seeds of each of 36 random starts (seeds
 //! 1234, 555 and 777; scratch) no start's mean velocity NEES over the
 //! samples holding kept steps exceeded 2.1, where dropping gave up to 7.2
