@@ -2926,20 +2926,12 @@ fn the_likelihood_picks_the_plant_that_made_the_samples() {
     let u = SVector::zeros();
     let sigma = 1e-4;
     let base = KalmanParams::new(20.0, sigma);
-    let candidates = [
-        ("no plant", base),
-        ("5 µs", base.with_plant_step(5e-6)),
-        ("10 µs", base.with_plant_step(1e-5)),
-        (
-            "10 µs off the grid",
-            base.with_plant_step(1e-5).with_plant_grid(false),
-        ),
-        ("20 µs", base.with_plant_step(2e-5)),
-        (
-            "Siconos's law, 10 µs",
-            base.with_plant(StepParams::siconos(1e-5)),
-        ),
-    ];
+    let [none, fine, plant, off, coarse] = common::runs::plant_candidates(base);
+    let siconos = (
+        "Siconos's law, 10 µs",
+        base.with_plant(StepParams::siconos(1e-5)),
+    );
+    let candidates = [none, fine, plant, off, coarse, siconos];
     let params = candidates.map(|(_, p)| p);
     // the pick among all the candidates, and the log-likelihood of no
     // plant; with `glitches`, samples moved by 1 m, which every filter

@@ -2,7 +2,9 @@
 //! for an estimator, seeded Gaussian measurement noise, and the error
 //! figures (`tests/observer.rs`, `tests/kalman.rs`).
 
-use moreau::{Estimate, Model, MoreauJean, Observer, ObserverError, State, StepParams};
+use moreau::{
+    Estimate, KalmanParams, Model, MoreauJean, Observer, ObserverError, State, StepParams,
+};
 use moreau_models::Parabola;
 use nalgebra::{SVector, Vector2};
 
@@ -289,4 +291,23 @@ pub fn example_1_runs() -> Vec<(String, Start2, u64)> {
         }
     }
     runs
+}
+
+/// The plants a record may have come from, for `pick_by_likelihood`: no
+/// plant (`base`, a rigid model right about the machine), the crate's law
+/// at 5, 10 and 20 µs on the samples' grid, and 10 µs off it; with
+/// their names.
+pub fn plant_candidates<const N: usize>(
+    base: KalmanParams<f64, N>,
+) -> [(&'static str, KalmanParams<f64, N>); 5] {
+    [
+        ("no plant", base),
+        ("5 µs", base.with_plant_step(5e-6)),
+        ("10 µs", base.with_plant_step(1e-5)),
+        (
+            "10 µs off the grid",
+            base.with_plant_step(1e-5).with_plant_grid(false),
+        ),
+        ("20 µs", base.with_plant_step(2e-5)),
+    ]
 }

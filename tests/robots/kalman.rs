@@ -16,7 +16,8 @@
 //! contact projections need come from the URDF through `model!`.
 
 use crate::common::runs::{
-    Gauss, Reference, Scored, brackets, measure, observe_counting, reference, score,
+    Gauss, Reference, Scored, brackets, measure, observe_counting, plant_candidates, reference,
+    score,
 };
 use moreau::{
     KalmanParams, Model, ObserverParams, ReducedOrder, SaltationKalman, Sensitivities,
@@ -452,17 +453,7 @@ fn process_noise_tuned_on_one_panda_record_holds_on_others() {
 fn the_likelihood_picks_the_pandas_plant() {
     let panda = Panda::<f64>::new();
     let u = SVector::zeros();
-    let base = KalmanParams::new(VELOCITY_BOUND, SIGMA);
-    let candidates = [
-        ("no plant", base),
-        ("5 µs", base.with_plant_step(5e-6)),
-        ("10 µs", base.with_plant_step(1e-5)),
-        (
-            "10 µs off the grid",
-            base.with_plant_step(1e-5).with_plant_grid(false),
-        ),
-        ("20 µs", base.with_plant_step(2e-5)),
-    ];
+    let candidates = plant_candidates(KalmanParams::new(VELOCITY_BOUND, SIGMA));
     let params = candidates.map(|(_, p)| p);
     for n in 0..4 {
         let record = panda_run(n);
