@@ -187,41 +187,52 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
         spread.scaled(T::one() / total)
     }
 
-    /// The smallest `yᵀ S⁻¹ y` over the state and the alternatives, for
-    /// the innovation `y` of the state (`solve` applies `S⁻¹`): a sample
-    /// that one of them explains is no outlier.
-    pub fn least_nis(
+    /// Each alternative's normalised innovation squared `y_aᵀ S⁻¹ y_a`,
+    /// `y_a = y − H Δ_a`, for the innovation `y` of the state (`solve`
+    /// applies `S⁻¹`; the slots past [`Mixture::len`] hold zero): computed
+    /// once per sample, for the gate ([`Mixture::least_nis`]) and the
+    /// weights ([`Mixture::update`]).
+    pub fn innovations(
         &self,
         y: &SVector<T, N>,
         solve: impl Fn(&SVector<T, N>) -> SVector<T, N>,
-    ) -> T {
-        let mut least = y.dot(&solve(y));
-        for a in 0..self.len {
+    ) -> [T; ALTERNATIVES] {
+        let mut theirs = [T::zero(); ALTERNATIVES];
+        for (a, nis) in theirs.iter_mut().enumerate().take(self.len) {
             let ya = y - self.offsets[a].0;
-            least = least.min(ya.dot(&solve(&ya)));
+            *nis = ya.dot(&solve(&ya));
         }
-        least
+        theirs
     }
 
-    /// The update with the gain `(k_q, k_v)` of the state's innovation `y`
-    /// (`solve` applies `S⁻¹`): each alternative reweighed by its own
+    /// The smallest normalised innovation squared over the state (`own`)
+    /// and the alternatives (`theirs`, [`Mixture::innovations`]): a sample
+    /// that one of them explains is no outlier.
+    pub fn least_nis(&self, own: T, theirs: &[T; ALTERNATIVES]) -> T {
+        theirs[..self.len]
+            .iter()
+            .fold(own, |least, &nis| least.min(nis))
+    }
+
+    /// The update with the gain `(k_q, k_v)` of the state's innovation,
+    /// whose normalised square is `own` and the alternatives' `theirs`
+    /// ([`Mixture::innovations`]): each alternative reweighed by its own
     /// innovation's likelihood and moved by `(I − K H)`; then the most
     /// likely becomes the state (returned: the move of the state, to add
     /// to it); a non-finite one is dropped ([`Mixture::merge_close`] then
     /// joins those under [`PRUNE`] to the state).
     pub fn update(
         &mut self,
-        y: &SVector<T, N>,
+        (own, theirs): (T, &[T; ALTERNATIVES]),
         (k_q, k_v): (&nalgebra::SMatrix<T, N, N>, &nalgebra::SMatrix<T, N, N>),
-        solve: impl Fn(&SVector<T, N>) -> SVector<T, N>,
     ) -> Offset<T, N> {
         let half: T = nalgebra::convert(0.5);
-        let own = y.dot(&solve(y));
-        for a in 0..self.len {
-            let (q, v) = self.offsets[a];
-            let ya = y - q;
-            self.log_weights[a] -= half * (ya.dot(&solve(&ya)) - own);
-            self.offsets[a] = (q - k_q * q, v - k_v * q);
+        let len = self.len;
+        let steps = self.offsets.iter_mut().zip(&mut self.log_weights);
+        for (((q, v), log_weight), &nis) in steps.zip(theirs).take(len) {
+            *log_weight -= half * (nis - own);
+            *v -= k_v * *q;
+            *q -= k_q * *q;
         }
         self.rebase()
     }
@@ -338,7 +349,8 @@ mod tests {
         let y = Vector1::new(1.0);
         let solve = |x: &Vector1<f64>| x / 0.01;
         let (k_q, k_v) = (Matrix1::new(0.5), Matrix1::new(0.0));
-        let moved = m.update(&y, (&k_q, &k_v), solve);
+        let theirs = m.innovations(&y, solve);
+        let moved = m.update((y.dot(&solve(&y)), &theirs), (&k_q, &k_v));
         // the alternative's innovation is 0: it becomes the state, moved
         // by (I − K H) of its offset
         assert!((moved.0[0] - 0.5).abs() < 1e-15);
@@ -414,6 +426,7 @@ mod tests {
         let (q, _) = m.mean();
         assert!((q[0] - 1.0).abs() < 1e-15);
         assert!((m.spread().entry(0, 0) - 1.0).abs() < 1e-15);
-        assert!(m.least_nis(&Vector1::new(2.0), |x| *x) < 1e-15);
+        let y = Vector1::new(2.0);
+        assert!(m.least_nis(y.dot(&y), &m.innovations(&y, |x| *x)) < 1e-15);
     }
 }

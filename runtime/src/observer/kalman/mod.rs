@@ -1196,11 +1196,8 @@ where
         // (a sample that one of the steps a plant may have taken a recent
         // impact into explains is no outlier: module `mixture`)
         let mut mixture = propagation.mixture;
-        let gated = if mixture.is_empty() {
-            nis
-        } else {
-            mixture.least_nis(&y, |x| chol.solve(x))
-        };
+        let theirs = mixture.innovations(&y, |x| chol.solve(x));
+        let gated = mixture.least_nis(nis, &theirs);
         let (q_new, v_new) = if gated > gate && !kalman.inflated {
             kalman.outlier = true;
             outliers += 1;
@@ -1216,7 +1213,7 @@ where
             let (dq, dv) = if mixture.is_empty() {
                 (SVector::zeros(), SVector::zeros())
             } else {
-                let (dq, dv) = mixture.update(&y, (&k_q, &k_v), |x| chol.solve(x));
+                let (dq, dv) = mixture.update((nis, &theirs), (&k_q, &k_v));
                 // those the samples cannot tell from the state join it
                 let ((mq, mv), gained) = mixture.merge_close(&p);
                 p = p.add(&gained);
