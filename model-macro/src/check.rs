@@ -123,11 +123,11 @@ fn check_name_forms(cx: &Ctxt, spec: &ModelSpec) {
 }
 
 // Coordinates, velocities, parameters, inputs and definitions share one
-// namespace (expressions refer to all of them by name); constraint names must
-// differ from each other.
+// namespace (expressions refer to all of them by name), and the bodies have
+// their own (`scope.rs`); constraint names must differ from each other.
 fn check_duplicates(cx: &Ctxt, spec: &ModelSpec) {
     let mut seen: std::collections::HashMap<&str, &str> = std::collections::HashMap::new();
-    for (name, what) in spec.declared() {
+    for (name, what) in spec.values() {
         if let Some(first) = seen.get(name.text.as_str()) {
             cx.error(
                 name.loc,
@@ -138,6 +138,12 @@ fn check_duplicates(cx: &Ctxt, spec: &ModelSpec) {
             );
         } else {
             seen.insert(&name.text, what);
+        }
+    }
+    let mut bodies: HashSet<&str> = HashSet::new();
+    for b in &spec.bodies {
+        if !bodies.insert(&b.name.text) {
+            cx.error(b.name.loc, format!("duplicate body `{}`", b.name.text));
         }
     }
     let mut constraints: HashSet<&str> = HashSet::new();
@@ -180,11 +186,13 @@ fn expressions(spec: &ModelSpec) -> Vec<(String, &Expr)> {
 }
 
 // Every name in an expression is declared; a definition is used only after
-// it is defined (definitions are read in order, so none is recursive).
+// it is defined (definitions are read in order, so none is recursive). A
+// body's name used as a value is `check_body_references`'s to report.
 fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     for (i, d) in spec.definitions.iter().enumerate() {
         d.expr.visit(&mut |name, loc| match scope.get(name) {
-            None => unknown(cx, spec, name, loc),
+            None if scope.body(name).is_none() => unknown(cx, spec, name, loc),
+            None => {}
             Some(Symbol::Definition(j)) if j >= i => cx.error(
                 loc,
                 format!("definition `{name}` is used before it is defined (definitions are read in order)"),
@@ -194,7 +202,7 @@ fn check_unknown_names(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     }
     for (_, e) in expressions(spec).into_iter().skip(spec.definitions.len()) {
         e.visit(&mut |name, loc| {
-            if scope.get(name).is_none() {
+            if scope.get(name).is_none() && scope.body(name).is_none() {
                 unknown(cx, spec, name, loc);
             }
         });
@@ -405,16 +413,10 @@ fn check_numbers_finite(cx: &Ctxt, spec: &ModelSpec) {
 // A body's parent is `world` or another body, and following parents from
 // any body reaches `world` (the tree has no cycle).
 fn check_tree(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
-    let parent_of = |i: usize| -> Option<usize> {
-        let p = spec.bodies[i].parent.as_ref()?;
-        match scope.get(&p.text) {
-            Some(Symbol::Body(j)) => Some(j),
-            _ => None,
-        }
-    };
+    let parent_of = |i: usize| scope.body(&spec.bodies[i].parent.as_ref()?.text);
     for (i, b) in spec.bodies.iter().enumerate() {
         if let Some(p) = &b.parent
-            && !matches!(scope.get(&p.text), Some(Symbol::Body(_)))
+            && scope.body(&p.text).is_none()
         {
             cx.error(
                 p.loc,
@@ -453,9 +455,9 @@ fn check_tree(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
 fn check_body_fields(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     let check = |e: &Expr, what: &str| {
         e.visit(&mut |name, loc| match scope.get(name) {
-            None => unknown(cx, spec, name, loc),
+            None if scope.body(name).is_none() => unknown(cx, spec, name, loc),
             Some(Symbol::Var(Var::Parameter(_)) | Symbol::Pi) => {}
-            Some(_) => cx.error(
+            _ => cx.error(
                 loc,
                 format!("{what} may name only parameters, but it uses `{name}`"),
             ),
@@ -487,7 +489,7 @@ fn check_body_references(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
         match &e.kind {
             ExprKind::Num(_) => {}
             ExprKind::Name(name) => {
-                if let Some(Symbol::Body(_)) = scope.get(name) {
+                if scope.get(name).is_none() && scope.body(name).is_some() {
                     cx.error(
                         e.loc,
                         format!("`{name}` is a body, not a number: use `position_x({name}, x, y, z)` (or `_y`, `_z`) for the world position of one of its points"),
@@ -500,11 +502,16 @@ fn check_body_references(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
                 walk(cx, scope, b);
             }
             ExprKind::Frame(kind, axis, body, point) => {
-                match scope.get(body) {
-                    Some(Symbol::Body(_)) | None => {}
-                    Some(_) => cx.error(
+                let call = kind.functions()[*axis];
+                match (scope.body(body), scope.get(body)) {
+                    (Some(_), _) => {}
+                    (None, Some(_)) => cx.error(
                         e.loc,
-                        format!("`{body}` is not a body: the first argument of `{}` names a body of `{}`", kind.functions()[*axis], keys::BODIES),
+                        format!("`{body}` is not a body: the first argument of `{call}` names a body of `{}`", keys::BODIES),
+                    ),
+                    (None, None) => cx.error(
+                        e.loc,
+                        format!("unknown body `{body}`: the first argument of `{call}` names a body of `{}` (a link of the URDF)", keys::BODIES),
                     ),
                 }
                 point.iter().for_each(|c| walk(cx, scope, c));

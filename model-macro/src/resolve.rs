@@ -139,15 +139,15 @@ pub(crate) struct TreeBody {
 pub(crate) fn resolve<'a>(spec: &'a ModelSpec, scope: &Scope<'_>) -> Option<Resolved<'a>> {
     let mut definitions = Vec::with_capacity(spec.definitions.len());
     for (i, d) in spec.definitions.iter().enumerate() {
-        let e = d
-            .expr
-            .try_map(&mut |name: &String, _| match scope.get(name)? {
+        let e = d.expr.try_map(
+            &mut |name: &String, _, space| match scope.lookup(name, space)? {
                 Symbol::Definition(j) if j >= i => None,
                 found => Some(found),
-            })?;
+            },
+        )?;
         definitions.push(e);
     }
-    let expr = |e: &Expr| e.try_map(&mut |name: &String, _| scope.get(name));
+    let expr = |e: &Expr| e.try_map(&mut |name: &String, _, space| scope.lookup(name, space));
     let kinetic = match &spec.kinetic {
         Some(k) => Some(expr(k)?),
         None => None,
@@ -217,17 +217,14 @@ pub(crate) fn resolve<'a>(spec: &'a ModelSpec, scope: &Scope<'_>) -> Option<Reso
 /// written comes first). `None` on a cycle or an unknown parent (reported
 /// by the checks).
 fn tree(spec: &ModelSpec, scope: &Scope<'_>) -> Option<Vec<TreeBody>> {
-    let expr = |e: &Expr| e.try_map(&mut |name: &String, _| scope.get(name));
+    let expr = |e: &Expr| e.try_map(&mut |name: &String, _, space| scope.lookup(name, space));
     let three = |e: &[Expr; 3]| Some([expr(&e[0])?, expr(&e[1])?, expr(&e[2])?]);
     let parents: Vec<Option<usize>> = spec
         .bodies
         .iter()
         .map(|b| match &b.parent {
             None => Some(None),
-            Some(p) => match scope.get(&p.text)? {
-                Symbol::Body(j) => Some(Some(j)),
-                _ => None,
-            },
+            Some(p) => Some(Some(scope.body(&p.text)?)),
         })
         .collect::<Option<_>>()?;
     let mut placed: Vec<Option<usize>> = vec![None; spec.bodies.len()];

@@ -207,16 +207,22 @@ impl ModelSpec {
         self.constraints[i].restitution.or(self.restitution)
     }
 
-    /// Every name the model declares in the one namespace of expressions
+    /// Every name the model declares in the namespace of values
     /// (coordinates, velocities, parameters, inputs, definitions), with
     /// what it is, in declaration order.
-    pub fn declared(&self) -> impl Iterator<Item = (&Name, &'static str)> {
+    pub fn values(&self) -> impl Iterator<Item = (&Name, &'static str)> {
         self.coordinates
             .iter()
             .flat_map(|c| [(&c.q, "a coordinate"), (&c.v, "a velocity")])
             .chain(self.parameters.iter().map(|p| (&p.name, "a parameter")))
             .chain(self.inputs.iter().map(|i| (i, "an input")))
             .chain(self.definitions.iter().map(|d| (&d.name, "a definition")))
+    }
+
+    /// Every name the model declares: the values, then the bodies (their
+    /// own namespace: `scope.rs`).
+    pub fn declared(&self) -> impl Iterator<Item = (&Name, &'static str)> {
+        self.values()
             .chain(self.bodies.iter().map(|b| (&b.name, "a body")))
     }
 }

@@ -98,9 +98,20 @@ pub(crate) enum ExprKind<N> {
     /// One world coordinate (0: x, 1: y, 2: z) of a point or a direction
     /// fixed in a body, given in the body's frame:
     /// `position_z(hand, 0, 0, 0.1)`, `direction_z(hand, 0, 0, 1)`. The body
-    /// is a name like any other (bodies share the one namespace); resolution
-    /// checks that it names a body.
+    /// is a name of the bodies' own namespace (a URDF names its links and
+    /// its joints apart, and a link may share its joint's name): [`Expr::visit`]
+    /// does not see it, and [`Expr::try_map`] maps it by its own function.
     Frame(Fixed, usize, N, Box<[Expr<N>; 3]>),
+}
+
+/// The namespace a name of an expression is read in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Space {
+    /// Coordinates, velocities, parameters, inputs, definitions, `t`, `pi`.
+    Value,
+    /// The bodies, named only as the first argument of `position_x` and
+    /// its kin.
+    Body,
 }
 
 /// What a body-frame call maps to the world.
@@ -133,7 +144,8 @@ impl Fixed {
 }
 
 impl<N> Expr<N> {
-    /// Calls `f` on every name this expression uses, in reading order.
+    /// Calls `f` on every name this expression uses as a value, in reading
+    /// order (not the body of `position_x` and its kin: [`Space::Body`]).
     pub fn visit<'a>(&'a self, f: &mut impl FnMut(&'a N, Loc)) {
         match &self.kind {
             ExprKind::Num(_) => {}
@@ -143,20 +155,18 @@ impl<N> Expr<N> {
                 a.visit(f);
                 b.visit(f);
             }
-            ExprKind::Frame(_, _, body, point) => {
-                f(body, self.loc);
-                point.iter().for_each(|c| c.visit(f));
-            }
+            ExprKind::Frame(_, _, _, point) => point.iter().for_each(|c| c.visit(f)),
         }
     }
 
-    /// The same expression with every name mapped by `f`; `None` if `f`
-    /// gives `None` for any name (after calling it on every name, so that
-    /// every failure can be reported).
-    pub fn try_map<M>(&self, f: &mut impl FnMut(&N, Loc) -> Option<M>) -> Option<Expr<M>> {
+    /// The same expression with every name mapped by `f`, told the
+    /// namespace the name is read in; `None` if `f` gives `None` for any
+    /// name (after calling it on every name, so that every failure can be
+    /// reported).
+    pub fn try_map<M>(&self, f: &mut impl FnMut(&N, Loc, Space) -> Option<M>) -> Option<Expr<M>> {
         let kind = match &self.kind {
             ExprKind::Num(x) => ExprKind::Num(*x),
-            ExprKind::Name(name) => ExprKind::Name(f(name, self.loc)?),
+            ExprKind::Name(name) => ExprKind::Name(f(name, self.loc, Space::Value)?),
             ExprKind::Neg(a) => ExprKind::Neg(Box::new(a.try_map(f)?)),
             ExprKind::Func(func, a) => ExprKind::Func(*func, Box::new(a.try_map(f)?)),
             ExprKind::Binary(op, a, b) => {
@@ -168,7 +178,7 @@ impl<N> Expr<N> {
                 ExprKind::Atan2(Box::new(a?), Box::new(b?))
             }
             ExprKind::Frame(kind, axis, body, point) => {
-                let body = f(body, self.loc);
+                let body = f(body, self.loc, Space::Body);
                 let [x, y, z] = &**point;
                 let (x, y, z) = (x.try_map(f), y.try_map(f), z.try_map(f));
                 ExprKind::Frame(*kind, *axis, body?, Box::new([x?, y?, z?]))
