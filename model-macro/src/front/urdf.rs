@@ -23,6 +23,16 @@
 //!   fixed joints (Pinocchio's `buildReducedModel` at the zero
 //!   configuration).
 //!
+//! - a URDF name that is not an identifier of the model's language
+//!   (Allegro's joint `joint_8.0`, Romeo's link `LFoot/FSR/CenterFront_sensor`)
+//!   becomes one ([`identifier`]): every character other than an ASCII
+//!   letter, digit or `_` becomes `_`, a leading digit gets a `_` before
+//!   it, and a Rust keyword or prelude value (`type`, `None`) a `_` after
+//!   it; two names of one kind (links, or joints) that become the same are
+//!   an error naming both. `locked` and `limits` take a joint by either
+//!   name. A link may share a joint's name: bodies are a namespace of their
+//!   own (`scope.rs`).
+//!
 //! `floating` (a quaternion base, out of scope) and `planar` joints are
 //! refused with an error that says why,
 //! as are `mimic` joints that are not locked; every problem in the file is
@@ -32,7 +42,9 @@ use std::collections::HashMap;
 
 use crate::expr::{Expr, ExprKind};
 use crate::loc::Loc;
-use crate::spec::{Body, Coordinate, Joint, JointKind, Name, Number};
+use crate::spec::{
+    Body, Coordinate, Joint, JointKind, Name, Number, PRELUDE_VALUES, RUST_KEYWORDS,
+};
 
 /// A joint or link of the URDF, as read.
 struct UrdfJoint<'a> {
@@ -67,9 +79,54 @@ pub(crate) struct Imported {
 
 /// A joint's position limits, as the URDF gives them.
 pub(crate) struct Limit {
+    /// The joint's name in the URDF.
     pub joint: String,
+    /// Its coordinate's name ([`identifier`] of `joint`).
+    pub coordinate: String,
     pub lower: f64,
     pub upper: f64,
+}
+
+/// The identifier a URDF name becomes in the model (see the module docs):
+/// `joint_8.0` → `joint_8_0`, `iris__/imu_link` → `iris___imu_link`, `3d`
+/// → `_3d`, `type` → `type_`; an identifier is itself. A name with no
+/// ASCII letter or digit becomes `_`, which the checks refuse.
+pub(crate) fn identifier(name: &str) -> String {
+    let mut id: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    if id.is_empty() || id.starts_with(|c: char| c.is_ascii_digit()) {
+        id.insert(0, '_');
+    }
+    if RUST_KEYWORDS.contains(&id.as_str()) || PRELUDE_VALUES.contains(&id.as_str()) {
+        id.push('_');
+    }
+    id
+}
+
+/// Whether the model's `written` names the URDF joint `joint`: by its URDF
+/// name or by its coordinate's.
+pub(crate) fn names_joint(written: &str, joint: &str) -> bool {
+    written == joint || written == identifier(joint)
+}
+
+/// Two names of one `kind` of the URDF that become the same identifier;
+/// `names` are the names with where each is written (`path:line:column`).
+fn clashes(kind: &str, names: &[(&str, String)], errors: &mut Vec<String>) {
+    let mut first: HashMap<String, &str> = HashMap::new();
+    for (name, at) in names {
+        let id = identifier(name);
+        match first.get(&id) {
+            Some(other) if other != name => errors.push(format!(
+                "{at}: the {kind}s `{other}` and `{name}` both become `{id}` (a name of the model is letters, digits and `_`): rename one in the URDF"
+            )),
+            Some(_) => {}
+            None => {
+                first.insert(id, name);
+            }
+        }
+    }
 }
 
 /// Reads the URDF `text` (shown in messages as `display`). `loc` is where
@@ -107,6 +164,8 @@ pub(crate) fn import(
     }
     let mut links: Vec<(&str, Inertial)> = Vec::new();
     let mut joints: Vec<UrdfJoint<'_>> = Vec::new();
+    // the names, with where each is written
+    let (mut link_names, mut joint_names) = (Vec::new(), Vec::new());
     for node in root.children().filter(|n| n.is_element()) {
         match node.tag_name().name() {
             "link" => {
@@ -115,19 +174,23 @@ pub(crate) fn import(
                 };
                 let inertial = inertial(node, &at, &mut errors);
                 links.push((name, inertial));
+                link_names.push((name, at(node)));
             }
             "joint" => {
                 if let Some(j) = joint(node, locked, &at, &mut errors) {
+                    joint_names.push((j.name, at(node)));
                     joints.push(j);
                 }
             }
             _ => {}
         }
     }
+    clashes("link", &link_names, &mut errors);
+    clashes("joint", &joint_names, &mut errors);
     let root = check_tree(display, &links, &joints, &mut errors);
     let mut problems: Vec<(Loc, String)> = at_file(errors);
     for l in locked {
-        if !joints.iter().any(|j| j.name == l.text) {
+        if !joints.iter().any(|j| names_joint(&l.text, j.name)) {
             problems.push((
                 l.loc,
                 format!(
@@ -216,7 +279,7 @@ fn walk(
     };
     let three = |v: [f64; 3]| v.map(number);
     let name = |text: &str| Name {
-        text: text.to_string(),
+        text: identifier(text),
         loc,
     };
     while let Some((i, parent)) = stack.pop() {
@@ -224,6 +287,7 @@ fn walk(
         if let (Some((lower, upper)), true) = (j.limit, j.kind != JointKind::Fixed) {
             imported.limits.push(Limit {
                 joint: j.name.to_string(),
+                coordinate: identifier(j.name),
                 lower,
                 upper,
             });
@@ -231,7 +295,7 @@ fn walk(
         let coordinate = (j.kind != JointKind::Fixed).then(|| {
             imported.coordinates.push(Coordinate {
                 q: name(j.name),
-                v: name(&format!("d{}", j.name)),
+                v: name(&format!("d{}", identifier(j.name))),
             });
             imported.coordinates.len() - 1
         });
@@ -406,7 +470,7 @@ fn joint<'a>(
         _ => None,
     };
     let (name, kind) = (name?, kind?);
-    let is_locked = locked.iter().any(|l| l.text == name);
+    let is_locked = locked.iter().any(|l| names_joint(&l.text, name));
     let kind = match kind {
         _ if is_locked => JointKind::Fixed,
         "revolute" | "continuous" => JointKind::Revolute,
@@ -455,4 +519,38 @@ fn joint<'a>(
         axis,
         limit,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{identifier, names_joint};
+    use crate::spec::is_identifier;
+
+    #[test]
+    fn a_urdf_name_becomes_an_identifier() {
+        for (urdf, model) in [
+            ("shoulder_pan_joint", "shoulder_pan_joint"),
+            ("joint_8.0", "joint_8_0"),
+            ("iris__/imu_link", "iris___imu_link"),
+            (
+                "LFoot/FSR/CenterFront_sensor",
+                "LFoot_FSR_CenterFront_sensor",
+            ),
+            ("left wheel", "left_wheel"),
+            ("3d_camera", "_3d_camera"),
+            ("type", "type_"),
+            ("None", "None_"),
+            ("", "_"),
+            ("-", "_"),
+            ("ø", "_"),
+        ] {
+            assert_eq!(identifier(urdf), model, "{urdf:?}");
+        }
+        // a name with nothing to keep is refused by the checks
+        assert!(!is_identifier(&identifier("ø")));
+        assert!(is_identifier(&identifier("joint_8.0")));
+        assert!(names_joint("joint_8.0", "joint_8.0"));
+        assert!(names_joint("joint_8_0", "joint_8.0"));
+        assert!(!names_joint("joint_8", "joint_8.0"));
+    }
 }

@@ -112,7 +112,10 @@ fn limit_constraints(
     display: &str,
 ) {
     for name in wanted {
-        let Some(limit) = found.iter().find(|l| l.joint == name.text) else {
+        let Some(limit) = found
+            .iter()
+            .find(|l| super::urdf::names_joint(&name.text, &l.joint))
+        else {
             cx.error(
                 name.loc,
                 format!(
@@ -124,7 +127,7 @@ fn limit_constraints(
         };
         let loc = name.loc;
         let node = |kind| Box::new(Expr { kind, loc });
-        let q = || node(ExprKind::Name(name.text.clone()));
+        let q = || node(ExprKind::Name(limit.coordinate.clone()));
         let x = |v| node(ExprKind::Num(v));
         for (suffix, h) in [
             ("lower", ExprKind::Binary(BinOp::Sub, q(), x(limit.lower))),
@@ -132,14 +135,14 @@ fn limit_constraints(
         ] {
             spec.constraints.push(Constraint {
                 name: Name {
-                    text: format!("{}_{suffix}", name.text),
+                    text: format!("{}_{suffix}", limit.coordinate),
                     loc,
                 },
                 h: Expr { kind: h, loc },
                 restitution: None,
                 doc: vec![format!(
                     "The {suffix} limit of joint `{}` (from the URDF).",
-                    name.text
+                    limit.joint
                 )],
             });
         }
