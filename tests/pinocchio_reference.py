@@ -86,6 +86,22 @@ ROBOTS = [
         [],
         [("FR_foot", [0.0, 0.0, 0.0]), ("RL_foot", [0.0, 0.0, 0.0])],
     ),
+    # a link and a joint of the same name (`gripper`): the point is the link's
+    (
+        "so100",
+        "tests/robots/urdf/so_arm_description/so100.urdf",
+        "so_arm_description/urdf/so100.urdf",
+        [],
+        [("gripper", [0.01, -0.02, 0.05]), ("jaw", [0.0, 0.0, 0.0])],
+    ),
+    # names that are not identifiers (`joint_0.0`, `link_3.0_tip`)
+    (
+        "allegro",
+        "tests/robots/urdf/allegro_hand_description/allegro_left_hand.urdf",
+        "allegro_hand_description/urdf/allegro_left_hand.urdf",
+        [],
+        [("link_15.0_tip", [0.0, 0.0, 0.0]), ("link_3.0_tip", [0.01, 0.0, 0.0])],
+    ),
 ]
 
 
@@ -140,7 +156,8 @@ def reference(name, urdf, wheel_rel, locked, points):
         pin.updateFramePlacements(model, data)
         out = []
         for link, r in points:
-            fid = model.getFrameId(link)
+            # the link's frame, not a joint's of the same name
+            fid = model.getFrameId(link, pin.FrameType.BODY)
             assert model.frames[fid].name == link, link
             oMf = data.oMf[fid]
             world_r = oMf.rotation @ np.array(r)

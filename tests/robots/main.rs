@@ -29,3 +29,5 @@ moreau::model!(file = "examples/ur5_table.yaml");
 moreau::model!(file = "tests/robots/panda.yaml");
 moreau::model!(file = "tests/robots/serial_12.yaml");
 moreau::model!(file = "tests/robots/go1.yaml");
+moreau::model!(file = "tests/robots/so100.yaml");
+moreau::model!(file = "tests/robots/allegro.yaml");

@@ -3,7 +3,9 @@
 //! `tests/robots/panda.yaml` (URDFs from example-robot-data, shipped in
 //! `tests/robots/urdf/`), `tests/robots/slider_arm.yaml` and
 //! `tests/robots/serial_12.yaml` (URDFs written for the tests) and
-//! `tests/robots/go1.yaml` (Unitree Go1's legs, example-robot-data) compiled
+//! `tests/robots/go1.yaml` (Unitree Go1's legs, example-robot-data),
+//! `tests/robots/so100.yaml` (a link and a joint of the same name) and
+//! `tests/robots/allegro.yaml` (names that are not identifiers) compiled
 //! by `model!`, compared with the values that
 //! `tests/pinocchio_reference.py` wrote with Pinocchio at 8 seeded
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
@@ -24,7 +26,7 @@ use moreau::{Model, Sensitivities};
 use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
 
-use crate::{Go1, Panda, Serial12, SliderArm, Ur5};
+use crate::{Allegro, Go1, Panda, Serial12, SliderArm, So100, Ur5};
 
 /// `tests/robots/ur5.yaml` written inline, the URDF named by `urdf = "...";`.
 mod inline {
@@ -133,10 +135,23 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
     joints: [&str; N],
     floor: f64,
 ) {
+    compare_named(model, robot, joints, joints, floor);
+}
+
+/// [`compare`] where the model's coordinates (`coordinates`) are not the
+/// URDF's joint names (`joints`, Pinocchio's): names that are not
+/// identifiers.
+fn compare_named<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize>(
+    model: &M,
+    robot: &str,
+    coordinates: [&str; N],
+    joints: [&str; N],
+    floor: f64,
+) {
     let data = fixture(robot);
     assert_eq!(
         M::INFO.coordinates,
-        joints,
+        coordinates,
         "the coordinates are the URDF's moving joints"
     );
     let order = pinocchio_order(&data, joints);
@@ -279,6 +294,51 @@ const GO1_JOINTS: [&str; 12] = [
 #[test]
 fn go1_matches_pinocchio() {
     compare(&Go1::<f64>::new(), "go1", GO1_JOINTS, 0.4 - 0.02);
+}
+
+/// The SO-100 arm: its jaw's joint and the link it moves are both called
+/// `gripper`, and `position_x(gripper, ...)` (`tests/robots/so100.yaml`)
+/// is the link's point, as Pinocchio's frame of the link `gripper` is.
+#[test]
+fn so100_matches_pinocchio() {
+    compare(
+        &So100::<f64>::new(),
+        "so100",
+        [
+            "shoulder_pan",
+            "shoulder_lift",
+            "elbow_flex",
+            "wrist_flex",
+            "wrist_roll",
+            "gripper",
+        ],
+        0.5,
+    );
+}
+
+/// The Allegro hand: its joints `joint_0.0`, ... are the coordinates
+/// `joint_0_0`, ..., its links `link_3.0_tip`, ... the bodies
+/// `link_3_0_tip`, ... (`tests/robots/allegro.yaml`); the fingers in the
+/// file's order (8–11, 4–7, 0–3, 12–15), which Pinocchio sorts by name.
+#[test]
+fn allegro_matches_pinocchio() {
+    let fingers = [8, 4, 0, 12];
+    let urdf: Vec<String> = fingers
+        .iter()
+        .flat_map(|f| (*f..f + 4).map(|j| format!("joint_{j}.0")))
+        .collect();
+    let ours: Vec<String> = fingers
+        .iter()
+        .flat_map(|f| (*f..f + 4).map(|j| format!("joint_{j}_0")))
+        .collect();
+    compare_named(
+        &Allegro::<f64>::new(),
+        "allegro",
+        std::array::from_fn::<_, 16, _>(|i| ours[i].as_str()),
+        std::array::from_fn::<_, 16, _>(|i| urdf[i].as_str()),
+        0.5,
+    );
+    assert_eq!(Allegro::<f64>::INFO.velocities[0], "djoint_8_0");
 }
 
 #[test]
