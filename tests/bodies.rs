@@ -363,3 +363,66 @@ fn directions_are_the_bodys_rotation() {
         }
     }
 }
+
+moreau::model! {
+    /// Two point masses on a planar arm whose elbow mimics its shoulder:
+    /// the elbow turns by `k θ + o` when the shoulder turns by `θ`
+    /// (`mimic`, as URDF's `<mimic>`), so the arm has one coordinate.
+    pub struct Coupled;
+    parameters { m1: 1.2, m2: 0.8, l1: 0.7, l2: 0.5, g: 9.81 }
+    gravity = [0, -g, 0];
+    bodies {
+        upper: { joint: revolute(th: dth), axis: [0, 0, 1], mass: m1, com: [l1, 0, 0] },
+        lower: {
+            parent: upper,
+            joint: revolute,
+            mimic: th,
+            multiplier: -0.4,
+            offset: 0.3,
+            axis: [0, 0, 1],
+            xyz: [l1, 0, 0],
+            mass: m2,
+            com: [l2, 0, 0],
+        },
+    }
+    constraints { floor: position_y(lower, l2, 0, 0) + 1 >= 0 }
+    restitution = 0.5;
+}
+
+/// A joint that mimics another (`mimic: th, multiplier: k, offset: o`):
+/// the arm's one-coordinate mass matrix, gravity, forces and tip against
+/// the closed form of two point masses, the elbow at `φ = (1 + k) θ + o`
+/// in the world: `M = m1 l1² + m2 (l1² + (1 + k)² l2² + 2 (1 + k) l1 l2
+/// cos(φ − θ))`, `G = g (m1 l1 cos θ + m2 (l1 cos θ + (1 + k) l2 cos φ))`.
+#[test]
+fn a_mimicking_joint_follows_its_coordinate() {
+    let model = Coupled::<f64>::new();
+    assert_eq!(Coupled::<f64>::INFO.coordinates, ["th"]);
+    let (m1, m2, l1, l2, g, k, o) = (1.2, 0.8, 0.7, 0.5, 9.81, -0.4, 0.3);
+    let mut state = 7_u64;
+    for _ in 0..8 {
+        let th = 3.0 * uniform(&mut state);
+        let dth = 2.0 * uniform(&mut state);
+        let (q, v) = (SVector::<f64, 1>::new(th), SVector::<f64, 1>::new(dth));
+        let phi = (1.0 + k) * th + o;
+        let mass = m1 * l1 * l1
+            + m2 * (l1 * l1
+                + (1.0 + k) * (1.0 + k) * l2 * l2
+                + 2.0 * (1.0 + k) * l1 * l2 * (phi - th).cos());
+        let gravity = g * (m1 * l1 * th.cos() + m2 * (l1 * th.cos() + (1.0 + k) * l2 * phi.cos()));
+        // C v = ½ M'(θ) θ̇² for one coordinate; M' = −2 m2 (1 + k) k l1 l2 sin(φ − θ)
+        let dmass = -2.0 * m2 * (1.0 + k) * k * l1 * l2 * (phi - th).sin();
+        close(model.mass(&q)[(0, 0)], mass, "M");
+        close(model.gravity(&q)[0], gravity, "G");
+        let u = SVector::<f64, 0>::zeros();
+        close(
+            model.forces(0.0, &q, &v, &u)[0],
+            0.5 * dmass * dth * dth + gravity,
+            "F = C v + G",
+        );
+        let tip = l1 * th.sin() + l2 * phi.sin();
+        close(model.gaps(&q)[0], tip + 1.0, "h");
+        let dtip = l1 * th.cos() + l2 * (1.0 + k) * phi.cos();
+        close(model.gap_jacobian(&q)[(0, 0)], dtip, "J");
+    }
+}

@@ -30,6 +30,7 @@ pub(crate) fn check(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
     check_tree(cx, spec, scope);
     check_body_fields(cx, spec, scope);
     check_body_references(cx, spec, scope);
+    check_mimics(cx, spec, scope);
 }
 
 // Every declared name becomes a Rust identifier (a field, a binding or the
@@ -444,6 +445,28 @@ fn check_tree(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
                 }
                 Some(j) => at = j,
                 None => break,
+            }
+        }
+    }
+}
+
+// A joint that mimics another follows a coordinate of the model (of another
+// joint or written), by a finite multiplier and offset.
+fn check_mimics(cx: &Ctxt, spec: &ModelSpec, scope: &Scope<'_>) {
+    for b in &spec.bodies {
+        let Some(m) = &b.joint.mimic else { continue };
+        if scope.coordinate(&m.coordinate.text).is_none() {
+            cx.error(
+                m.coordinate.loc,
+                format!(
+                    "body `{}`'s joint mimics `{}`, which is not a coordinate of this model",
+                    b.name.text, m.coordinate.text
+                ),
+            );
+        }
+        for n in [m.multiplier, m.offset] {
+            if !n.value.is_finite() {
+                cx.error(n.loc, "expected a finite number");
             }
         }
     }

@@ -42,7 +42,14 @@ pub(crate) const AXIS: &str = "axis";
 pub(crate) const XYZ: &str = "xyz";
 pub(crate) const RPY: &str = "rpy";
 pub(crate) const VELOCITY: &str = "velocity";
-pub(crate) const JOINT_KEYS: [&str; 6] = [TYPE, NAME, VELOCITY, AXIS, XYZ, RPY];
+/// A joint that follows another's coordinate (URDF's `<mimic>`), by a
+/// multiplier (default 1) and an offset (default 0).
+pub(crate) const MIMIC: &str = "mimic";
+pub(crate) const MULTIPLIER: &str = "multiplier";
+pub(crate) const OFFSET: &str = "offset";
+pub(crate) const JOINT_KEYS: [&str; 9] = [
+    TYPE, NAME, VELOCITY, MIMIC, MULTIPLIER, OFFSET, AXIS, XYZ, RPY,
+];
 /// The joint types of `bodies`.
 pub(crate) const JOINT_TYPES: [&str; 3] = ["revolute", "prismatic", "fixed"];
 /// The name of the fixed base as a parent.

@@ -124,6 +124,21 @@ fn body(s: &mut String, spec: &ModelSpec, b: &Body) {
         JointKind::Fixed => "fixed",
     };
     let _ = write!(s, "    {}: {{{}: {kind}", keys::JOINT, keys::TYPE);
+    if let Some(m) = &j.mimic {
+        let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
+        let _ = write!(
+            s,
+            ", {}: {}, {}: {}, {}: {}, {}: [{}]",
+            keys::MIMIC,
+            m.coordinate.text,
+            keys::MULTIPLIER,
+            fmt_number(m.multiplier.value),
+            keys::OFFSET,
+            fmt_number(m.offset.value),
+            keys::AXIS,
+            axis.join(", ")
+        );
+    }
     if let Some(i) = j.coordinate {
         let c = &spec.coordinates[i];
         let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
@@ -213,6 +228,7 @@ mod tests {
                 upper: { joint: revolute(a1: w1), axis: [0, -1, 0], xyz: [0, 0, 0.3], mass: m, com: [0, 0, -l / 2], inertia: [1, 0, 0, 1, 0, 2] },
                 tip: { parent: upper, joint: fixed, xyz: [0, 0, -l], rpy: [0.1, 0, 0], mass: 0.25 },
                 slider: { parent: upper, joint: prismatic(s), axis: [1, 0, 0], mass: 1 },
+                twin: { parent: upper, joint: prismatic, mimic: s, multiplier: -1, offset: 0.02, axis: [1, 0, 0], mass: 1 },
             }
             coordinates { x: vx }
             parameters { m: 1.5, l: 0.9, g: 9.81 }
@@ -248,6 +264,12 @@ mod tests {
         assert_eq!(super::canonical(&again), text);
         assert!(
             text.contains("h: \"position_z(tip, 0, 0, 0) + 1\""),
+            "{text}"
+        );
+        assert!(
+            text.contains(
+                "joint: {type: prismatic, mimic: s, multiplier: -1, offset: 0.02, axis: [1, 0, 0]"
+            ),
             "{text}"
         );
     }

@@ -120,8 +120,11 @@ pub(crate) struct TreeBody {
     /// `None` for the world.
     pub parent: Option<usize>,
     pub kind: JointKind,
-    /// The joint's coordinate.
+    /// The joint's coordinate, or the one it follows.
     pub coordinate: Option<usize>,
+    /// The joint's angle (or displacement) is `scale · q + offset`, `q`
+    /// its coordinate: `(1, 0)` but for a joint that mimics another.
+    pub follow: (f64, f64),
     /// The unit axis.
     pub axis: [f64; 3],
     pub xyz: [Expr<Symbol>; 3],
@@ -246,7 +249,15 @@ fn tree(spec: &ModelSpec, scope: &Scope<'_>) -> Option<Vec<TreeBody>> {
                 index: i,
                 parent: parents[i].map(|p| placed[p].expect("parents are placed first")),
                 kind: b.joint.kind,
-                coordinate: b.joint.coordinate,
+                coordinate: match &b.joint.mimic {
+                    Some(m) => Some(scope.coordinate(&m.coordinate.text)?),
+                    None => b.joint.coordinate,
+                },
+                follow: b
+                    .joint
+                    .mimic
+                    .as_ref()
+                    .map_or((1.0, 0.0), |m| (m.multiplier.value, m.offset.value)),
                 axis: a.map(|x| x / norm),
                 xyz: three(&b.joint.xyz)?,
                 rpy: three(&b.joint.rpy)?,

@@ -81,13 +81,26 @@ pub(crate) enum JointKind {
 pub(crate) struct Joint {
     pub kind: JointKind,
     /// The index of its coordinate in `ModelSpec::coordinates` (not for
-    /// fixed joints): the front ends declare one coordinate per moving
-    /// joint.
+    /// fixed joints, nor for a joint that mimics another): the front ends
+    /// declare one coordinate per moving joint.
     pub coordinate: Option<usize>,
+    /// A moving joint without a coordinate of its own: it follows another's.
+    pub mimic: Option<Mimic>,
     /// The axis in the joint's frame, as numbers (normalized when lowered).
     pub axis: [Number; 3],
     pub xyz: [Expr; 3],
     pub rpy: [Expr; 3],
+}
+
+/// A joint that follows another's coordinate (URDF's `<mimic>`: a
+/// gripper's second finger, a coupled phalanx): its angle (or
+/// displacement) is `multiplier · q + offset`, `q` the coordinate named
+/// `coordinate`, and its velocity `multiplier · q̇`.
+#[derive(Clone, Debug)]
+pub(crate) struct Mimic {
+    pub coordinate: Name,
+    pub multiplier: Number,
+    pub offset: Number,
 }
 
 /// A rigid body of the kinematic tree (`bodies`).

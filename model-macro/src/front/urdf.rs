@@ -33,9 +33,15 @@
 //!   name. A link may share a joint's name: bodies are a namespace of their
 //!   own (`scope.rs`).
 //!
+//! - a joint with `<mimic joint multiplier offset>` follows the joint it
+//!   names: no coordinate of its own, its angle `multiplier · q + offset`
+//!   of that joint's coordinate `q` (a [`Mimic`]), as Pinocchio's
+//!   `buildModelFromUrdf(…, mimic=True)` reads it. Locked, it is fixed at
+//!   zero as any locked joint; the joint it follows must be a moving joint
+//!   of the file, neither locked nor itself mimicking one.
+//!
 //! `floating` (a quaternion base, out of scope) and `planar` joints are
-//! refused with an error that says why,
-//! as are `mimic` joints that are not locked; every problem in the file is
+//! refused with an error that says why; every problem in the file is
 //! reported at once, each with the URDF's `path:line:column`.
 
 use std::collections::HashMap;
@@ -43,7 +49,7 @@ use std::collections::HashMap;
 use crate::expr::{Expr, ExprKind};
 use crate::loc::Loc;
 use crate::spec::{
-    Body, Coordinate, Joint, JointKind, Name, Number, PRELUDE_VALUES, RUST_KEYWORDS,
+    Body, Coordinate, Joint, JointKind, Mimic, Name, Number, PRELUDE_VALUES, RUST_KEYWORDS,
 };
 
 /// A joint or link of the URDF, as read.
@@ -57,6 +63,9 @@ struct UrdfJoint<'a> {
     axis: [f64; 3],
     /// `lower` and `upper` of `<limit>`, when both are given.
     limit: Option<(f64, f64)>,
+    /// `<mimic>`: the joint followed, the multiplier and the offset, and
+    /// where it is written (not for a locked joint).
+    mimic: Option<(&'a str, f64, f64, String)>,
 }
 
 #[derive(Default, Clone, Copy)]
@@ -187,6 +196,7 @@ pub(crate) fn import(
     }
     clashes("link", &link_names, &mut errors);
     clashes("joint", &joint_names, &mut errors);
+    check_mimics(&joints, locked, &mut errors);
     let root = check_tree(display, &links, &joints, &mut errors);
     let mut problems: Vec<(Loc, String)> = at_file(errors);
     for l in locked {
@@ -284,7 +294,8 @@ fn walk(
     };
     while let Some((i, parent)) = stack.pop() {
         let j = &joints[i];
-        if let (Some((lower, upper)), true) = (j.limit, j.kind != JointKind::Fixed) {
+        let moving = j.kind != JointKind::Fixed;
+        if let (Some((lower, upper)), true, None) = (j.limit, moving, &j.mimic) {
             imported.limits.push(Limit {
                 joint: j.name.to_string(),
                 coordinate: identifier(j.name),
@@ -292,7 +303,16 @@ fn walk(
                 upper,
             });
         }
-        let coordinate = (j.kind != JointKind::Fixed).then(|| {
+        let mimic = j
+            .mimic
+            .as_ref()
+            .filter(|_| moving)
+            .map(|(followed, m, o, _)| Mimic {
+                coordinate: name(followed),
+                multiplier: Number { value: *m, loc },
+                offset: Number { value: *o, loc },
+            });
+        let coordinate = (moving && mimic.is_none()).then(|| {
             imported.coordinates.push(Coordinate {
                 q: name(j.name),
                 v: name(&format!("d{}", identifier(j.name))),
@@ -306,6 +326,7 @@ fn walk(
             joint: Joint {
                 kind: j.kind,
                 coordinate,
+                mimic,
                 axis: j.axis.map(|value| Number { value, loc }),
                 xyz: three(j.xyz),
                 rpy: three(j.rpy),
@@ -496,15 +517,16 @@ fn joint<'a>(
             return None;
         }
     };
-    if let Some(m) = child(node, "mimic")
-        && !is_locked
-    {
-        errors.push(format!(
-            "{}: joint `{name}` mimics another joint, which is not supported: list it in `locked` to hold it at zero",
-            at(m)
-        ));
-        return None;
-    }
+    // a fixed joint's `<mimic>` moves nothing (Talos's reduced grippers)
+    let mimic = match child(node, "mimic") {
+        Some(m) if !is_locked && kind != JointKind::Fixed => {
+            let followed = attribute(m, "joint", at, errors)?;
+            let [multiplier] = numbers(Some(m), "multiplier", [1.0], at, errors);
+            let [offset] = numbers(Some(m), "offset", [0.0], at, errors);
+            Some((followed, multiplier, offset, at(m)))
+        }
+        _ => None,
+    };
     if kind != JointKind::Fixed && axis.iter().all(|a| *a == 0.0) {
         errors.push(format!("{}: joint `{name}` has a zero axis", at(node)));
         return None;
@@ -518,7 +540,31 @@ fn joint<'a>(
         rpy,
         axis,
         limit,
+        mimic,
     })
+}
+
+/// Each `<mimic>` names a moving joint of the file that is neither locked
+/// nor mimicking one itself.
+fn check_mimics(joints: &[UrdfJoint<'_>], locked: &[Name], errors: &mut Vec<String>) {
+    for j in joints {
+        let Some((followed, _, _, at)) = &j.mimic else {
+            continue;
+        };
+        let name = j.name;
+        let why = match joints.iter().find(|f| f.name == *followed) {
+            None => "which is not a joint this URDF has (or could read)",
+            Some(_) if locked.iter().any(|l| names_joint(&l.text, followed)) => {
+                "which is locked: lock this joint too"
+            }
+            Some(f) if f.kind == JointKind::Fixed => {
+                "which is fixed: it has no coordinate to follow"
+            }
+            Some(f) if f.mimic.is_some() => "which mimics another itself: follow that one instead",
+            Some(_) => continue,
+        };
+        errors.push(format!("{at}: joint `{name}` mimics `{followed}`, {why}"));
+    }
 }
 
 #[cfg(test)]

@@ -107,6 +107,16 @@ fn place(
         Some(i) => g.var(layout.id(crate::scope::Var::Coordinate(i))),
         None => zero,
     };
+    // A joint that mimics another: `scale · q + offset`, its axis `scale S`.
+    let (multiplier, shift) = b.follow;
+    let follows = (multiplier, shift) != (1.0, 0.0);
+    let q = if follows {
+        let (factor, shift) = (g.constant(multiplier), g.constant(shift));
+        let scaled = g.mul(factor, q);
+        g.add(scaled, shift)
+    } else {
+        q
+    };
     let (r, offset) = match b.kind {
         JointKind::Revolute => {
             let rot = rodrigues(g, b.axis, q);
@@ -124,6 +134,12 @@ fn place(
     // The axis in world coordinates (a revolute joint does not turn its
     // own axis).
     let a = mat_vec(g, &r_joint_frame, axis);
+    let a = if follows {
+        let factor = g.constant(multiplier);
+        scale(g, a, factor)
+    } else {
+        a
+    };
     let motion = match b.kind {
         JointKind::Revolute => Some([a, cross(g, p, a)]),
         JointKind::Prismatic => Some([[zero; 3], a]),

@@ -1,5 +1,5 @@
 // An inline model naming a URDF with a floating joint (a quaternion base,
-// out of scope), a planar joint, an unknown joint type, a mimic joint,
+// out of scope), a planar joint, an unknown joint type, a joint mimicking it,
 // malformed numbers and a joint to a missing link, and locking a joint the
 // URDF does not have: every problem at once, those of the file at the path
 // with the URDF's file:line:column, the unknown joint at its name.

@@ -1,10 +1,13 @@
 //! The inline front end's reading of a kinematic tree:
-//! `bodies { name: { parent, joint, axis, xyz, rpy, mass, com, inertia } }`,
+//! `bodies { name: { parent, joint, axis, xyz, rpy, mass, com, inertia } }`
+//! (and `mimic`, `multiplier`, `offset` for a joint that follows another's
+//! coordinate: `joint: revolute, mimic: q1, multiplier: -1`),
 //! `gravity = [x, y, z];`, and a URDF: `urdf = "path";`, `locked { j1 }`,
 //! `limits { j2 }`, imported by `front/urdf_keys.rs` exactly as the YAML
 //! keys `urdf`, `locked` and `limits` are.
 
 use super::*;
+use crate::front::follows;
 use crate::front::urdf_keys::import_urdf;
 
 /// The URDF items of an inline model, kept until every item is read.
@@ -126,6 +129,7 @@ fn body(cx: &Ctxt, spec: &mut ModelSpec, e: Entry) -> Option<Body> {
     };
     let (mut parent, mut joint, mut axis, mut mass) = (None, None, None, None);
     let (mut xyz, mut rpy, mut com, mut inertia) = (None, None, None, None);
+    let (mut mimic, mut multiplier, mut offset) = (None, None, None);
     for f in entries(cx, g) {
         let at = Loc::span(f.colon);
         let group = match f.value.as_slice() {
@@ -141,9 +145,12 @@ fn body(cx: &Ctxt, spec: &mut ModelSpec, e: Entry) -> Option<Body> {
             (keys::COM, Some(g)) => com = vector::<3>(cx, g, at, "`com`"),
             (keys::INERTIA, Some(g)) => inertia = vector::<6>(cx, g, at, "`inertia` (ixx, ixy, ixz, iyy, iyz, izz)"),
             (keys::MASS, _) => mass = f.expr(cx),
+            (keys::MIMIC, _) => mimic = f.single_name(cx, "the coordinate this joint follows"),
+            (keys::MULTIPLIER, _) => multiplier = f.number(cx),
+            (keys::OFFSET, _) => offset = f.number(cx),
             (other, _) => cx.error(
                 f.name.loc,
-                format!("unknown or malformed `{other}` in a body; a body has parent, joint, axis, xyz, rpy, mass, com, inertia"),
+                format!("unknown or malformed `{other}` in a body; a body has parent, joint, mimic, multiplier, offset, axis, xyz, rpy, mass, com, inertia"),
             ),
         }
     }
@@ -155,7 +162,18 @@ fn body(cx: &Ctxt, spec: &mut ModelSpec, e: Entry) -> Option<Body> {
         cx.error(here, format!("missing `mass` in body `{}`", e.name.text));
         return None;
     };
-    let coordinate = joint_coordinate(cx, spec, kind, &tokens, at)?;
+    let mimic = follows(cx, kind, mimic, (multiplier, offset), at);
+    let coordinate = match (&mimic, tokens.as_slice()) {
+        (Some(_), [_]) => None,
+        (Some(_), _) => {
+            cx.error(
+                at,
+                "a joint that mimics another has no coordinate of its own: write `joint: revolute` (or `prismatic`) beside `mimic`",
+            );
+            return None;
+        }
+        (None, _) => joint_coordinate(cx, spec, kind, &tokens, at)?,
+    };
     let axis = match (kind, axis) {
         (JointKind::Fixed, _) => [0.0, 0.0, 1.0].map(|value| Number { value, loc: here }),
         (_, Some(a)) => a,
@@ -170,6 +188,7 @@ fn body(cx: &Ctxt, spec: &mut ModelSpec, e: Entry) -> Option<Body> {
         joint: Joint {
             kind,
             coordinate,
+            mimic,
             axis,
             xyz: xyz.unwrap_or_else(|| [zero(), zero(), zero()]),
             rpy: rpy.unwrap_or_else(|| [zero(), zero(), zero()]),

@@ -2,6 +2,7 @@
 //! `urdf`, `locked`, `limits`, is read by `front/urdf_keys.rs`).
 
 use super::*;
+use crate::front::follows;
 
 impl Walker<'_> {
     /// `[x, y, z]`: three expressions.
@@ -144,6 +145,7 @@ impl Walker<'_> {
         };
         let (mut kind, mut name, mut velocity, mut axis) = (None, None, None, None);
         let (mut xyz, mut rpy) = (None, None);
+        let (mut mimic, mut multiplier, mut offset) = (None, None, None);
         let mut ok = true;
         for (key, value) in entries {
             let Some(k) = self.key(key) else { continue };
@@ -154,6 +156,9 @@ impl Walker<'_> {
                 }
                 keys::NAME => name = self.name(value, "the joint's coordinate"),
                 keys::VELOCITY => velocity = self.name(value, "the joint's velocity"),
+                keys::MIMIC => mimic = self.name(value, "the coordinate this joint follows"),
+                keys::MULTIPLIER => multiplier = self.number(value, "`multiplier`"),
+                keys::OFFSET => offset = self.number(value, "`offset`"),
                 keys::AXIS => {
                     axis = self.axis(value);
                     ok &= axis.is_some();
@@ -185,7 +190,19 @@ impl Walker<'_> {
             );
         }
         let kind = kind?;
-        let coordinate = self.joint_coordinate(spec, kind, name, velocity, here)?;
+        let mimic = follows(self.cx, kind, mimic, (multiplier, offset), here);
+        let coordinate = match &mimic {
+            Some(_) => {
+                for n in name.iter().chain(&velocity) {
+                    self.cx.error(
+                        n.loc,
+                        "a joint that mimics another has no coordinate or velocity of its own",
+                    );
+                }
+                None
+            }
+            None => self.joint_coordinate(spec, kind, name, velocity, here)?,
+        };
         let unit = |value| Number { value, loc: here };
         let axis = match (kind, axis) {
             (JointKind::Fixed, _) => [unit(0.0), unit(0.0), unit(1.0)],
@@ -200,6 +217,7 @@ impl Walker<'_> {
         Some(Joint {
             kind,
             coordinate,
+            mimic,
             axis,
             xyz: xyz.unwrap_or_else(|| [zero(), zero(), zero()]),
             rpy: rpy.unwrap_or_else(|| [zero(), zero(), zero()]),
