@@ -94,6 +94,15 @@ ROBOTS = [
         [],
         [("gripper", [0.01, -0.02, 0.05]), ("jaw", [0.0, 0.0, 0.0])],
     ),
+    # the Panda's fingers as the URDF has them: the second mimics the first
+    # (Pinocchio's `mimic=True`), a point on each finger
+    (
+        "panda_mimic",
+        "tests/robots/urdf/panda_description/panda.urdf",
+        "panda_description/urdf/panda.urdf",
+        [],
+        [("panda_rightfinger", [0.0, 0.01, 0.04]), ("panda_leftfinger", [0.0, -0.01, 0.04])],
+    ),
     # names that are not identifiers (`joint_0.0`, `link_3.0_tip`)
     (
         "allegro",
@@ -119,12 +128,18 @@ def wheel_copy_matches(repo_path: Path, wheel_rel) -> bool:
     raise SystemExit(f"example-robot-data has no {wanted}")
 
 
+def moving(model):
+    """The joints with a coordinate of their own: not those that mimic
+    another (nv = 0)."""
+    return [i for i in range(1, model.njoints) if model.joints[i].nv > 0]
+
+
 def configuration(model, angles):
     """Pinocchio's configuration vector for one coordinate per joint: a
     continuous joint (nq = 2) is stored as (cos θ, sin θ)."""
     q = []
-    for j, x in zip(model.joints[1:], angles):
-        q.extend([math.cos(x), math.sin(x)] if j.nq == 2 else [x])
+    for i, x in zip(moving(model), angles):
+        q.extend([math.cos(x), math.sin(x)] if model.joints[i].nq == 2 else [x])
     return np.array(q)
 
 
@@ -136,12 +151,15 @@ def reference(name, urdf, wheel_rel, locked, points):
     path = ROOT / urdf
     if not wheel_copy_matches(path, wheel_rel):
         raise SystemExit(f"{urdf}: differs from the example-robot-data wheel's {wheel_rel}")
-    full = pin.buildModelFromUrdf(str(path))
+    # the URDF's mimic joints follow their joints where none is locked (the
+    # Panda's first fixture locks both fingers, as buildReducedModel needs)
+    full = pin.buildModelFromUrdf(str(path), mimic=not locked)
     ids = [full.getJointId(j) for j in locked]
     model = pin.buildReducedModel(full, ids, pin.neutral(full)) if ids else full
     data = model.createData()
-    assert all(j.nv == 1 for j in model.joints[1:]), "a fixed base of 1-dof joints"
-    joints = [model.names[i] for i in range(1, model.njoints)]
+    assert all(model.joints[i].nv == 1 for i in moving(model)), "a fixed base of 1-dof joints"
+    joints = [model.names[i] for i in moving(model)]
+    assert [model.joints[i].idx_v for i in moving(model)] == list(range(model.nv))
     rng = np.random.default_rng(11)
     samples = []
     for _ in range(SAMPLES):

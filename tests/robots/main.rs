@@ -31,3 +31,4 @@ moreau::model!(file = "tests/robots/serial_12.yaml");
 moreau::model!(file = "tests/robots/go1.yaml");
 moreau::model!(file = "tests/robots/so100.yaml");
 moreau::model!(file = "tests/robots/allegro.yaml");
+moreau::model!(file = "tests/robots/panda_fingers.yaml");

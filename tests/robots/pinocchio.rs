@@ -4,8 +4,9 @@
 //! `tests/robots/urdf/`), `tests/robots/slider_arm.yaml` and
 //! `tests/robots/serial_12.yaml` (URDFs written for the tests) and
 //! `tests/robots/go1.yaml` (Unitree Go1's legs, example-robot-data),
-//! `tests/robots/so100.yaml` (a link and a joint of the same name) and
-//! `tests/robots/allegro.yaml` (names that are not identifiers) compiled
+//! `tests/robots/so100.yaml` (a link and a joint of the same name),
+//! `tests/robots/allegro.yaml` (names that are not identifiers) and
+//! `tests/robots/panda_fingers.yaml` (a joint that mimics another) compiled
 //! by `model!`, compared with the values that
 //! `tests/pinocchio_reference.py` wrote with Pinocchio at 8 seeded
 //! configurations each (`tests/fixtures/pinocchio/*.json`): the mass
@@ -26,7 +27,7 @@ use moreau::{Model, Sensitivities};
 use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
 
-use crate::{Allegro, Go1, Panda, Serial12, SliderArm, So100, Ur5};
+use crate::{Allegro, Go1, Panda, PandaFingers, Serial12, SliderArm, So100, Ur5};
 
 /// `tests/robots/ur5.yaml` written inline, the URDF named by `urdf = "...";`.
 mod inline {
@@ -239,6 +240,30 @@ fn panda_matches_pinocchio() {
             "panda_joint5",
             "panda_joint6",
             "panda_joint7",
+        ],
+        0.5,
+    );
+}
+
+/// The Panda with its fingers as the URDF has them: the second finger's
+/// joint mimics the first's, so the eighth coordinate opens both
+/// (`tests/robots/panda_fingers.yaml`), beside Pinocchio's model read with
+/// `mimic=True`; a point on each finger, the right one on the mimicking
+/// joint.
+#[test]
+fn panda_with_mimicking_fingers_matches_pinocchio() {
+    compare(
+        &PandaFingers::<f64>::new(),
+        "panda_mimic",
+        [
+            "panda_joint1",
+            "panda_joint2",
+            "panda_joint3",
+            "panda_joint4",
+            "panda_joint5",
+            "panda_joint6",
+            "panda_joint7",
+            "panda_finger_joint1",
         ],
         0.5,
     );
