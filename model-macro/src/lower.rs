@@ -153,7 +153,13 @@ fn check_mass_diagonal(
         };
         if m <= 0.0 {
             let v = model.var_name(Var::Velocity(i));
-            let why = if m == 0.0 {
+            let moved_by_joint = model.bodies.iter().any(|b| b.coordinate == Some(i));
+            let why = if m == 0.0 && moved_by_joint {
+                let q = model.var_name(Var::Coordinate(i));
+                format!(
+                    "the joint of coordinate `{q}` moves no mass or inertia (M[{i},{i}] = 0; a massless link of a URDF: lock the joint)"
+                )
+            } else if m == 0.0 {
                 format!("the kinetic energy has no term in `{v}`^2 (M[{i},{i}] = ∂²T/∂{v}² = 0)")
             } else {
                 format!("M[{i},{i}] = ∂²T/∂{v}² = {m} is negative")
