@@ -125,33 +125,31 @@ fn body(s: &mut String, spec: &ModelSpec, b: &Body) {
     };
     let _ = write!(s, "    {}: {{{}: {kind}", keys::JOINT, keys::TYPE);
     if let Some(m) = &j.mimic {
-        let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
         let _ = write!(
             s,
-            ", {}: {}, {}: {}, {}: {}, {}: [{}]",
+            ", {}: {}, {}: {}, {}: {}",
             keys::MIMIC,
             m.coordinate.text,
             keys::MULTIPLIER,
             fmt_number(m.multiplier.value),
             keys::OFFSET,
             fmt_number(m.offset.value),
-            keys::AXIS,
-            axis.join(", ")
         );
     }
     if let Some(i) = j.coordinate {
         let c = &spec.coordinates[i];
-        let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
         let _ = write!(
             s,
-            ", {}: {}, {}: {}, {}: [{}]",
+            ", {}: {}, {}: {}",
             keys::NAME,
             c.q.text,
             keys::VELOCITY,
             c.v.text,
-            keys::AXIS,
-            axis.join(", ")
         );
+    }
+    if j.kind != JointKind::Fixed {
+        let axis: Vec<String> = j.axis.iter().map(|n| fmt_number(n.value)).collect();
+        let _ = write!(s, ", {}: [{}]", keys::AXIS, axis.join(", "));
     }
     let _ = writeln!(
         s,

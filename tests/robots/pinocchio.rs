@@ -128,9 +128,14 @@ fn state<const N: usize>(s: &Value, order: &[usize; N]) -> (SVector<f64, N>, SVe
 
 /// The points of the fixtures are read through the constraints: the first
 /// three give `1 − x`, `1 − y`, `z + floor` of the first point, the next
-/// three those of the second. `joints` are the model's coordinates, in its
-/// order; Pinocchio's values are taken in that order.
-fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize>(
+/// three those of the second (any constraints after them are not read).
+/// `joints` are the model's coordinates, in its order; Pinocchio's values
+/// are taken in that order.
+fn compare<
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>>,
+    const N: usize,
+    const K: usize,
+>(
     model: &M,
     robot: &str,
     joints: [&str; N],
@@ -142,7 +147,11 @@ fn compare<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize
 /// [`compare`] where the model's coordinates (`coordinates`) are not the
 /// URDF's joint names (`joints`, Pinocchio's): names that are not
 /// identifiers.
-fn compare_named<M: Model<N, 6, Scalar = f64, Input = SVector<f64, 0>>, const N: usize>(
+fn compare_named<
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>>,
+    const N: usize,
+    const K: usize,
+>(
     model: &M,
     robot: &str,
     coordinates: [&str; N],
@@ -227,22 +236,20 @@ fn inline_ur5_matches_pinocchio() {
     compare(&inline::Ur5::<f64>::new(), "ur5", UR5_JOINTS, 0.5);
 }
 
+/// The Panda's seven arm joints.
+const PANDA_ARM: [&str; 7] = [
+    "panda_joint1",
+    "panda_joint2",
+    "panda_joint3",
+    "panda_joint4",
+    "panda_joint5",
+    "panda_joint6",
+    "panda_joint7",
+];
+
 #[test]
 fn panda_matches_pinocchio() {
-    compare(
-        &Panda::<f64>::new(),
-        "panda",
-        [
-            "panda_joint1",
-            "panda_joint2",
-            "panda_joint3",
-            "panda_joint4",
-            "panda_joint5",
-            "panda_joint6",
-            "panda_joint7",
-        ],
-        0.5,
-    );
+    compare(&Panda::<f64>::new(), "panda", PANDA_ARM, 0.5);
 }
 
 /// The Panda with its fingers as the URDF has them: the second finger's
@@ -255,16 +262,7 @@ fn panda_with_mimicking_fingers_matches_pinocchio() {
     compare(
         &PandaFingers::<f64>::new(),
         "panda_mimic",
-        [
-            "panda_joint1",
-            "panda_joint2",
-            "panda_joint3",
-            "panda_joint4",
-            "panda_joint5",
-            "panda_joint6",
-            "panda_joint7",
-            "panda_finger_joint1",
-        ],
+        std::array::from_fn(|i| PANDA_ARM.get(i).copied().unwrap_or("panda_finger_joint1")),
         0.5,
     );
 }
