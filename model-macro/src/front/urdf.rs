@@ -251,11 +251,19 @@ fn check_tree<'a>(
         .filter(|name| !child_of.contains_key(name))
         .collect();
     if roots.len() != 1 && errors.is_empty() {
-        errors.push(format!(
-            "{display}: a URDF has one root link (a link that is no joint's child), found {}: {}",
-            roots.len(),
-            roots.join(", ")
-        ));
+        errors.push(if links.is_empty() {
+            format!("{display}: the URDF has no `<link>`: there is no robot to read")
+        } else if roots.is_empty() {
+            format!(
+                "{display}: a URDF has one root link (a link that is no joint's child), found none: the joints form a cycle"
+            )
+        } else {
+            format!(
+                "{display}: a URDF has one root link (a link that is no joint's child), found {}: {}",
+                roots.len(),
+                roots.join(", ")
+            )
+        });
     }
     (roots.len() == 1).then(|| roots[0])
 }

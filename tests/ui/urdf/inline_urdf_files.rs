@@ -38,6 +38,17 @@ moreau::model! {
     limits { elbow, 3 }
 }
 
+// A URDF with no links, and one whose joints leave no root.
+moreau::model! {
+    pub struct Empty;
+    urdf = "tests/ui/yaml/empty.urdf";
+}
+
+moreau::model! {
+    pub struct Cycle;
+    urdf = "tests/ui/yaml/cycle.urdf";
+}
+
 // The URDF named before the model's name.
 moreau::model!(urdf = "tests/ui/yaml/two_joints.urdf");
 
