@@ -63,9 +63,18 @@ struct UrdfJoint<'a> {
     axis: [f64; 3],
     /// `lower` and `upper` of `<limit>`, when both are given.
     limit: Option<(f64, f64)>,
-    /// `<mimic>`: the joint followed, the multiplier and the offset, and
-    /// where it is written (not for a locked joint).
-    mimic: Option<(&'a str, f64, f64, String)>,
+    /// `<mimic>`, on a moving joint that is not locked.
+    mimic: Option<UrdfMimic<'a>>,
+}
+
+/// A joint's `<mimic joint multiplier offset>`, as read.
+struct UrdfMimic<'a> {
+    /// The joint followed.
+    joint: &'a str,
+    multiplier: f64,
+    offset: f64,
+    /// Where it is written (`path:line:column`).
+    at: String,
 }
 
 #[derive(Default, Clone, Copy)]
@@ -311,15 +320,18 @@ fn walk(
                 upper,
             });
         }
-        let mimic = j
-            .mimic
-            .as_ref()
-            .filter(|_| moving)
-            .map(|(followed, m, o, _)| Mimic {
-                coordinate: name(followed),
-                multiplier: Number { value: *m, loc },
-                offset: Number { value: *o, loc },
-            });
+        // only a moving joint that is not locked has its `<mimic>` read
+        let mimic = j.mimic.as_ref().map(|m| Mimic {
+            coordinate: name(m.joint),
+            multiplier: Number {
+                value: m.multiplier,
+                loc,
+            },
+            offset: Number {
+                value: m.offset,
+                loc,
+            },
+        });
         let coordinate = (moving && mimic.is_none()).then(|| {
             imported.coordinates.push(Coordinate {
                 q: name(j.name),
@@ -528,10 +540,15 @@ fn joint<'a>(
     // a fixed joint's `<mimic>` moves nothing (Talos's reduced grippers)
     let mimic = match child(node, "mimic") {
         Some(m) if !is_locked && kind != JointKind::Fixed => {
-            let followed = attribute(m, "joint", at, errors)?;
+            let joint = attribute(m, "joint", at, errors)?;
             let [multiplier] = numbers(Some(m), "multiplier", [1.0], at, errors);
             let [offset] = numbers(Some(m), "offset", [0.0], at, errors);
-            Some((followed, multiplier, offset, at(m)))
+            Some(UrdfMimic {
+                joint,
+                multiplier,
+                offset,
+                at: at(m),
+            })
         }
         _ => None,
     };
@@ -556,7 +573,12 @@ fn joint<'a>(
 /// nor mimicking one itself.
 fn check_mimics(joints: &[UrdfJoint<'_>], locked: &[Name], errors: &mut Vec<String>) {
     for j in joints {
-        let Some((followed, _, _, at)) = &j.mimic else {
+        let Some(UrdfMimic {
+            joint: followed,
+            at,
+            ..
+        }) = &j.mimic
+        else {
             continue;
         };
         let name = j.name;
