@@ -84,6 +84,20 @@ fn limit_gaps_and_jacobians_are_the_urdf_numbers() {
 fn urdf_names_become_the_models_and_links_keep_their_own() {
     let info = Names::<f64>::INFO;
     assert_eq!(info.coordinates, ["joint_1", "elbow", "type_"]);
+    // the URDF's own names are kept beside them, and either finds the
+    // coordinate (a ROS `JointState` carries the URDF's)
+    assert_eq!(Names::<f64>::JOINT_NAMES, ["joint.1", "elbow", "type"]);
+    assert_eq!(inline::Names::<f64>::JOINT_NAMES, Names::<f64>::JOINT_NAMES);
+    for (name, index) in [
+        ("joint.1", 0),
+        ("joint_1", 0),
+        ("elbow", 1),
+        ("type", 2),
+        ("type_", 2),
+    ] {
+        assert_eq!(Names::<f64>::coordinate_index(name), Some(index), "{name}");
+    }
+    assert_eq!(Names::<f64>::coordinate_index("joint.2"), None);
     assert_eq!(info.velocities, ["djoint_1", "delbow", "dtype_"]);
     assert_eq!(
         info.constraints,
@@ -132,4 +146,19 @@ fn a_joint_is_locked_by_either_name() {
     assert_eq!(yaml.mass(&q), inline.mass(&q));
     // held at zero: the tool's x is 0.2 + (0.2 + s) cos(elbow)
     assert!((yaml.gaps(&q)[0] - (0.5 - 0.2 - 0.25 * 0.4_f64.cos())).abs() < 1e-14);
+}
+
+/// A model written without a URDF names each coordinate once:
+/// `JOINT_NAMES` are its `ModelInfo::coordinates`, and
+/// `coordinate_index` finds them.
+#[test]
+fn a_model_without_a_urdf_keeps_its_coordinates_names() {
+    use moreau_models::Parabola;
+    assert_eq!(
+        Parabola::<f64>::JOINT_NAMES,
+        Parabola::<f64>::INFO.coordinates
+    );
+    assert_eq!(Parabola::<f64>::JOINT_NAMES, ["x", "y"]);
+    assert_eq!(Parabola::<f64>::coordinate_index("y"), Some(1));
+    assert_eq!(Parabola::<f64>::coordinate_index("z"), None);
 }

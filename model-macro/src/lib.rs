@@ -26,7 +26,7 @@
 //!
 //! Follow a user name, say the coordinate `th1` of `models/double_pendulum.yaml`:
 //! the YAML front end reads it into `Coordinate { q: Name { text: "th1",
-//! loc } }`; `Scope::new` maps `"th1"` to `Symbol::Var(Var::Coordinate(0))`;
+//! loc }, .. }`; `Scope::new` maps `"th1"` to `Symbol::Var(Var::Coordinate(0))`;
 //! resolution rewrites every `Name("th1")` into that symbol; lowering turns
 //! it into the graph variable `VarLayout::id(Var::Coordinate(0))` (`VarId(0)`);
 //! emission binds it as `Local::Var(Var::Coordinate(0))`, printed as the

@@ -29,6 +29,9 @@ pub(crate) struct Number {
 pub(crate) struct Coordinate {
     pub q: Name,
     pub v: Name,
+    /// The URDF joint's own name, for a coordinate read from a URDF
+    /// (`joint_8.0`, where `q` is `joint_8_0`: `front::urdf::identifier`).
+    pub joint: Option<String>,
 }
 
 /// A parameter: a field of the generated type, with its default.

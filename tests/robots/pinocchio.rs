@@ -343,13 +343,11 @@ fn so100_matches_pinocchio() {
 /// `joint_0_0`, ..., its links `link_3.0_tip`, ... the bodies
 /// `link_3_0_tip`, ... (`tests/robots/allegro.yaml`); the fingers in the
 /// file's order (8–11, 4–7, 0–3, 12–15), which Pinocchio sorts by name.
+/// The generated `JOINT_NAMES` keep the URDF's names, and Pinocchio's
+/// model is matched by them.
 #[test]
 fn allegro_matches_pinocchio() {
     let fingers = [8, 4, 0, 12];
-    let urdf: Vec<String> = fingers
-        .iter()
-        .flat_map(|f| (*f..f + 4).map(|j| format!("joint_{j}.0")))
-        .collect();
     let ours: Vec<String> = fingers
         .iter()
         .flat_map(|f| (*f..f + 4).map(|j| format!("joint_{j}_0")))
@@ -358,9 +356,11 @@ fn allegro_matches_pinocchio() {
         &Allegro::<f64>::new(),
         "allegro",
         std::array::from_fn::<_, 16, _>(|i| ours[i].as_str()),
-        std::array::from_fn::<_, 16, _>(|i| urdf[i].as_str()),
+        Allegro::<f64>::JOINT_NAMES,
         0.5,
     );
+    assert_eq!(Allegro::<f64>::JOINT_NAMES[0], "joint_8.0");
+    assert_eq!(Allegro::<f64>::coordinate_index("joint_15.0"), Some(15));
     assert_eq!(Allegro::<f64>::INFO.velocities[0], "djoint_8_0");
 }
 

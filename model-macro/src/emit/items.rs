@@ -128,7 +128,8 @@ impl Emitter<'_, '_> {
         out
     }
 
-    /// `N`, `K`, `new` and `initial_state`.
+    /// `N`, `K`, `new`, `initial_state`, `JOINT_NAMES` and
+    /// `coordinate_index`.
     fn inherent_items(&self) -> TokenStream {
         let (name, bound) = (self.name(), bound());
         let (n, k) = (self.model.n(), self.model.k());
@@ -141,6 +142,11 @@ impl Emitter<'_, '_> {
         };
         let q0 = initial(&self.model.initial_q);
         let v0 = initial(&self.model.initial_v);
+        let coordinates = &self.model.spec.coordinates;
+        let joints = coordinates
+            .iter()
+            .map(|c| c.joint.as_deref().unwrap_or(&c.q.text));
+        let names = coordinates.iter().map(|c| &c.q.text);
         let (n, k) = (int(n), int(k));
         quote! {
             #[allow(non_snake_case, dead_code)]
@@ -161,6 +167,25 @@ impl Emitter<'_, '_> {
                 #[must_use]
                 pub fn initial_state() -> (#vec_n, #vec_n) {
                     (#q0, #v0)
+                }
+
+                /// Each coordinate's name as the model's source writes it: for
+                /// a coordinate read from a URDF, its joint's own name there
+                /// (`joint_8.0`, where `ModelInfo::coordinates` holds the
+                /// model's `joint_8_0`); for any other, the coordinate's name.
+                pub const JOINT_NAMES: [&'static str; #n] = [#(#joints),*];
+
+                /// The index of the coordinate `name` names, by its source's
+                /// name (`JOINT_NAMES`: what a ROS `JointState` message
+                /// carries for a URDF joint) or by the model's; `None` if
+                /// neither.
+                #[must_use]
+                pub fn coordinate_index(name: &str) -> ::core::option::Option<usize> {
+                    let model: [&'static str; #n] = [#(#names),*];
+                    Self::JOINT_NAMES
+                        .iter()
+                        .position(|&joint| joint == name)
+                        .or_else(|| model.iter().position(|&coordinate| coordinate == name))
                 }
             }
         }

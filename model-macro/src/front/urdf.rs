@@ -336,6 +336,7 @@ fn walk(
             imported.coordinates.push(Coordinate {
                 q: name(j.name),
                 v: name(&format!("d{}", identifier(j.name))),
+                joint: Some(j.name.to_string()),
             });
             imported.coordinates.len() - 1
         });

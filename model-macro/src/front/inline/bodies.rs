@@ -281,7 +281,7 @@ fn joint_coordinate(
                 text: format!("d{}", q.text),
                 loc: q.loc,
             });
-            spec.coordinates.push(Coordinate { q, v });
+            spec.coordinates.push(Coordinate { q, v, joint: None });
             Some(Some(spec.coordinates.len() - 1))
         }
         _ => {

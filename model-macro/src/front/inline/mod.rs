@@ -198,7 +198,11 @@ fn read_keyed(cx: &Ctxt, spec: &mut ModelSpec, key_text: &str, loc: Loc, rest: &
                 .into_iter()
                 .filter_map(|e| {
                     let v = e.single_name(cx, "its velocity's name, as in `x: vx`")?;
-                    Some(Coordinate { q: e.name, v })
+                    Some(Coordinate {
+                        q: e.name,
+                        v,
+                        joint: None,
+                    })
                 })
                 .collect();
             // Joint coordinates (when `bodies` came first) go after the

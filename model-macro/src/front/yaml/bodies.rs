@@ -272,7 +272,7 @@ impl Walker<'_> {
                     text: format!("d{}", q.text),
                     loc: q.loc,
                 });
-                spec.coordinates.push(Coordinate { q, v });
+                spec.coordinates.push(Coordinate { q, v, joint: None });
                 Some(Some(spec.coordinates.len() - 1))
             }
         }

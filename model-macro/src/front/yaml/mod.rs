@@ -414,6 +414,7 @@ impl Walker<'_> {
                     Some(Coordinate {
                         q: self.name(q, "a coordinate")?,
                         v: self.name(v, "a velocity")?,
+                        joint: None,
                     })
                 }
                 _ => {
