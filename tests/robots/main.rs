@@ -32,3 +32,4 @@ moreau::model!(file = "tests/robots/go1.yaml");
 moreau::model!(file = "tests/robots/so100.yaml");
 moreau::model!(file = "tests/robots/allegro.yaml");
 moreau::model!(file = "tests/robots/panda_fingers.yaml");
+moreau::model!(file = "tests/robots/panda_fingers_free.yaml");

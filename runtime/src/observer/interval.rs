@@ -710,12 +710,13 @@ where
     M: Model<N, K, Scalar = T>,
 {
     /// Newton's law at `at` ([`Contact`]), `ê` on `elastic` and `0` on
-    /// the rest of `set`: returns `w⁺`.
+    /// the rest of `set`: returns `w⁺`. A set met `together` takes one law
+    /// however opposed its gradients ([`checked`](Self::checked)).
     fn newton(
         &self,
         at: &Contact<'_, T, N, K>,
-        set: IndexSet<K>,
-        elastic: IndexSet<K>,
+        (set, elastic): (IndexSet<K>, IndexSet<K>),
+        together: bool,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, Law<T>), T> {
         let Contact { s, w, jac, chol } = *at;
@@ -727,7 +728,9 @@ where
         }
         let before = report.impulses;
         let (dv, law) = match self.impulse(jac, chol, w, &e.component_mul(&jw), set, report) {
-            Ok(dv) if set.len() > 1 => self.checked(at, (set, &e, &jw), before, dv, report)?,
+            Ok(dv) if set.len() > 1 => {
+                self.checked(at, (set, &e, &jw), (before, together), dv, report)?
+            }
             Ok(dv) => (dv, Law::Newton),
             // gradients nearly dependent (see `opposed`) can leave the
             // problem without a solution in floating point
@@ -757,14 +760,17 @@ where
     /// set, `w⁺ = w_p + e (w_p − w)` with `w_p` the plastic projection,
     /// takes its place; where the closure is of nearly opposite
     /// constraints ([`opposed`]), the constraints are met one at a time
-    /// ([`one_at_a_time`](Self::one_at_a_time)). The impulses recorded
-    /// since `before` are those of the law kept, which is returned with
-    /// `dv`.
+    /// ([`one_at_a_time`](Self::one_at_a_time)), unless the set is met
+    /// `together`: a fast impact beside a contact held along the piece
+    /// before it, or a set widened by a constraint its impulse turned
+    /// back (`Interval::meet`), which a time-stepping plant's step meets
+    /// with one law. The impulses recorded since `before` are those of
+    /// the law kept, which is returned with `dv`.
     fn checked(
         &self,
         at: &Contact<'_, T, N, K>,
         (set, e, jw): (IndexSet<K>, &SVector<T, K>, &SVector<T, K>),
-        before: SVector<T, K>,
+        (before, together): (SVector<T, K>, bool),
         mut dv: SVector<T, N>,
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<(SVector<T, N>, Law<T>), T> {
@@ -781,7 +787,7 @@ where
         }
         let minv_jt = chol.solve(&jac.transpose());
         let lambda = report.impulses - before;
-        if opposed(set, &lambda, jw, &(jac * (w + dv)), &(jac * minv_jt)) {
+        if !together && opposed(set, &lambda, jw, &(jac * (w + dv)), &(jac * minv_jt)) {
             report.impulses = before;
             dv = self.one_at_a_time(at, &minv_jt, set, e, report);
             law = Law::OneAtATime;
@@ -1629,7 +1635,7 @@ where
             jac: &jac,
             chol: &free.chol,
         };
-        Ok(self.newton(&at, c.contact, c.elastic, report)?.0)
+        Ok(self.newton(&at, (c.contact, c.elastic), false, report)?.0)
     }
 }
 
