@@ -157,9 +157,13 @@ where
             }
             *report = opened;
             set = set.union(joined);
-            for j in joined {
-                if at.jac.row(j).dot(&at.w.transpose()) < T::zero() {
-                    elastic.insert(j);
+            // (one that met this point approaching still bounces, within
+            // `max_impacts`)
+            if opened.impacts < self.params.max_impacts {
+                for j in joined {
+                    if at.jac.row(j).dot(&at.w.transpose()) < T::zero() {
+                        elastic.insert(j);
+                    }
                 }
             }
             (w_plus, law) = self.newton(at, (set, elastic), true, report)?;
