@@ -404,14 +404,15 @@ fn the_filter_follows_the_other_robots() {
 /// 27182), the fingers 2 cm open and at rest, every gap at least 2 cm
 /// open.
 ///
-/// On start 3 both fingertips strike the table at 2.0872 s, one of them
-/// resting on it: one at a time (the opposed gradients' rule) the
-/// resting fingertip was left approaching at 2.9 m/s and held as a
-/// persistent contact; at 1.398 s a fingertip that had just bounced was
-/// driven in again by the other's impulse at the same point, and held
-/// the same way. The prediction flew it 2 mm into the table, and the
-/// filter was 45 rad/s off the bracketing samples, (38) 18. Both are now
-/// one law on the pair (module docs of `runtime/src/observer/mod.rs`, the
+/// On start 3 one fingertip strikes the table at 2.0872 s, at 2.9 m/s,
+/// while the other rests on it: one at a time (the opposed gradients'
+/// rule) the striking one bounced, the resting one's closure drove it in
+/// again at 2.56 m/s, and, met once at that point already, it was held as
+/// a persistent contact while approaching. (On another start a fingertip
+/// that had just bounced was driven in again by the other's impulse at
+/// the same point, and held the same way.) The prediction flew it 2 mm
+/// into the table, and the filter was 45 rad/s off the bracketing
+/// samples, (38) 18. Both are now one law on the pair (module docs of `runtime/src/observer/mod.rs`, the
 /// contact rule): 6.3e-3 and 0.135.
 ///
 /// Asserted on every start: no restart and at most one sample refused by
