@@ -146,7 +146,6 @@ impl Emitter<'_, '_> {
         let joints = coordinates
             .iter()
             .map(|c| c.joint.as_deref().unwrap_or(&c.q.text));
-        let names = coordinates.iter().map(|c| &c.q.text);
         let (n, k) = (int(n), int(k));
         quote! {
             #[allow(non_snake_case, dead_code)]
@@ -181,7 +180,7 @@ impl Emitter<'_, '_> {
                 /// neither.
                 #[must_use]
                 pub fn coordinate_index(name: &str) -> ::core::option::Option<usize> {
-                    let model: [&'static str; #n] = [#(#names),*];
+                    let model = <Self as ::moreau::__private::Model<#n, #k>>::INFO.coordinates;
                     Self::JOINT_NAMES
                         .iter()
                         .position(|&joint| joint == name)

@@ -133,6 +133,17 @@ where
         (h, resolved): (&SVector<T, K>, IndexSet<K>),
         report: &mut UpdateReport<T, N, K>,
     ) -> Result<Met<T, N, K>, T> {
+        // a lone impact (nothing met at this point yet): the law alone,
+        // without the copy of the report that a widened set restores
+        if resolved.difference(set).is_empty() {
+            let (w_plus, law) = self.newton(at, (set, elastic), together, report)?;
+            return Ok(Met {
+                w_plus,
+                law,
+                set,
+                elastic,
+            });
+        }
         let opened = *report;
         let (mut w_plus, mut law) = self.newton(at, (set, elastic), together, report)?;
         // each round adds a constraint to the set: at most K rounds
