@@ -13,6 +13,11 @@
 //! `example_1_random_starts_beside_the_reduced_order_observer`, against
 //! 37 with the Gaussian: the choice of step was what was left.
 //!
+//! It also holds, in reserve, the other law an impact beside a held
+//! contact may have taken, had that contact hovered a hair open (module
+//! `propagate`, "A contact that may hover"): not part of the mean, weighed
+//! only where the state's law fails a sample, never joined to the state.
+//!
 //! # The sum of Gaussians
 //!
 //! Where the predicted instant's deviation is under half a step and a
@@ -100,6 +105,11 @@ pub const PRUNE: f64 = 1e-2;
 pub struct Mixture<T: RealField + Copy, const N: usize> {
     offsets: [Offset<T, N>; ALTERNATIVES],
     log_weights: [T; ALTERNATIVES],
+    /// Whether each alternative has a contact open that the state holds
+    /// ([`Mixture::push_open`]).
+    open: [bool; ALTERNATIVES],
+    /// When that contact's hop ends, for an open alternative.
+    lands: [T; ALTERNATIVES],
     len: usize,
 }
 
@@ -115,6 +125,8 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
         Self {
             offsets: [no_offset(); ALTERNATIVES],
             log_weights: [T::zero(); ALTERNATIVES],
+            open: [false; ALTERNATIVES],
+            lands: [T::zero(); ALTERNATIVES],
             len: 0,
         }
     }
@@ -145,8 +157,50 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
         if self.len < ALTERNATIVES {
             self.offsets[self.len] = offset;
             self.log_weights[self.len] = log_weight;
+            self.open[self.len] = false;
             self.len += 1;
         }
+    }
+
+    /// Adds an alternative, as [`Mixture::push`], in which a contact that
+    /// the state holds is open: the law of an impact beside a held contact
+    /// that may have hovered (`Jump::alternative`). Its offset follows the
+    /// free flow where the state's follows the contact (module
+    /// `propagate`) until `lands`, when its hop ends, and which is not part
+    /// of the mixture's mean ([`Mixture::mean`]) until it becomes the state
+    /// (ignored when full).
+    pub fn push_open(&mut self, offset: Offset<T, N>, log_weight: T, lands: T) {
+        if self.len < ALTERNATIVES {
+            self.push(offset, log_weight);
+            self.open[self.len - 1] = true;
+            self.lands[self.len - 1] = lands;
+        }
+    }
+
+    /// Drops every alternative with a contact open ([`Mixture::push_open`])
+    /// whose hop has ended by `t`.
+    pub fn drop_open(&mut self, t: T) {
+        let mut kept = 0;
+        for a in 0..self.len {
+            if !(self.open[a] && self.lands[a] <= t) {
+                self.move_slot(a, kept);
+                kept += 1;
+            }
+        }
+        self.len = kept;
+    }
+
+    /// Moves alternative `from` into slot `to`.
+    fn move_slot(&mut self, from: usize, to: usize) {
+        self.offsets[to] = self.offsets[from];
+        self.log_weights[to] = self.log_weights[from];
+        self.open[to] = self.open[from];
+        self.lands[to] = self.lands[from];
+    }
+
+    /// Whether alternative `a` has a contact open that the state holds.
+    pub fn is_open(&self, a: usize) -> bool {
+        self.open[a]
     }
 
     /// Carries every offset through the linear map `map` (a piece's
@@ -159,11 +213,12 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
     }
 
     /// The mixture's mean as an offset from the state: `Σ w_a Δ_a / (1 +
-    /// Σ w_a)`.
+    /// Σ w_a)` over the alternatives not held in reserve
+    /// ([`Mixture::push_open`]).
     pub fn mean(&self) -> Offset<T, N> {
         let mut total = T::one();
         let (mut q, mut v) = (SVector::zeros(), SVector::zeros());
-        for a in 0..self.len {
+        for a in (0..self.len).filter(|&a| !self.open[a]) {
             let w = self.log_weights[a].exp();
             total += w;
             q += self.offsets[a].0 * w;
@@ -173,12 +228,13 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
     }
 
     /// The spread of the means about the mixture's mean,
-    /// `Σ w_i (m_i − m̄)(m_i − m̄)ᵀ` over the state and the alternatives.
+    /// `Σ w_i (m_i − m̄)(m_i − m̄)ᵀ` over the state and the alternatives not
+    /// held in reserve.
     pub fn spread(&self) -> Blocks<T, N> {
         let (mq, mv) = self.mean();
         let mut total = T::one();
         let mut spread = Blocks::outer(&mq, &mv);
-        for a in 0..self.len {
+        for a in (0..self.len).filter(|&a| !self.open[a]) {
             let w = self.log_weights[a].exp();
             total += w;
             let (q, v) = self.offsets[a];
@@ -221,16 +277,23 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
     /// likely becomes the state (returned: the move of the state, to add
     /// to it); a non-finite one is dropped ([`Mixture::merge_close`] then
     /// joins those under [`PRUNE`] to the state).
+    ///
+    /// An alternative with a contact open ([`Mixture::push_open`]) is
+    /// weighed only where `weigh_open`: where the state's law fails the
+    /// sample (module `propagate`, "A contact that may hover").
     pub fn update(
         &mut self,
         (own, theirs): (T, &[T; ALTERNATIVES]),
         (k_q, k_v): (&nalgebra::SMatrix<T, N, N>, &nalgebra::SMatrix<T, N, N>),
+        weigh_open: bool,
     ) -> Offset<T, N> {
         let half: T = nalgebra::convert(0.5);
         let len = self.len;
         let steps = self.offsets.iter_mut().zip(&mut self.log_weights);
-        for (((q, v), log_weight), &nis) in steps.zip(theirs).take(len) {
-            *log_weight -= half * (nis - own);
+        for ((((q, v), log_weight), &nis), &open) in steps.zip(theirs).zip(&self.open).take(len) {
+            if weigh_open || !open {
+                *log_weight -= half * (nis - own);
+            }
             *v -= k_v * *q;
             *q -= k_q * *q;
         }
@@ -253,6 +316,18 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
         while a < self.len {
             let (dq, dv) = self.offsets[a];
             let light = self.log_weights[a] < floor;
+            if self.open[a] {
+                // another law, not the state's spread: dropped once light,
+                // never joined (module `propagate`, "A contact that may
+                // hover")
+                if light {
+                    self.len -= 1;
+                    self.move_slot(self.len, a);
+                } else {
+                    a += 1;
+                }
+                continue;
+            }
             if light || mahalanobis(p, &dq, &dv).is_some_and(|m| m < T::one()) {
                 let w = self.log_weights[a].exp();
                 let total = T::one() + w;
@@ -263,8 +338,7 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
                 // relative to its
                 let ln_total = total.ln();
                 self.len -= 1;
-                self.offsets[a] = self.offsets[self.len];
-                self.log_weights[a] = self.log_weights[self.len];
+                self.move_slot(self.len, a);
                 for b in 0..self.len {
                     self.offsets[b] = (self.offsets[b].0 - mq, self.offsets[b].1 - mv);
                     self.log_weights[b] -= ln_total;
@@ -295,9 +369,11 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
                 self.offsets[a] = (self.offsets[a].0 - dq, self.offsets[a].1 - dv);
                 self.log_weights[a] -= lw;
             }
-            // the old state takes the best one's place
+            // the old state takes the best one's place (its contacts are
+            // those the new state's flow follows, or open in both)
             self.offsets[b] = (-dq, -dv);
             self.log_weights[b] = -lw;
+            self.open[b] = false;
             moved = (dq, dv);
         }
         let mut kept = 0;
@@ -309,8 +385,7 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
                     .chain(self.offsets[a].1.iter())
                     .all(|x| x.is_finite());
             if finite {
-                self.offsets[kept] = self.offsets[a];
-                self.log_weights[kept] = self.log_weights[a];
+                self.move_slot(a, kept);
                 kept += 1;
             }
         }
@@ -350,7 +425,7 @@ mod tests {
         let solve = |x: &Vector1<f64>| x / 0.01;
         let (k_q, k_v) = (Matrix1::new(0.5), Matrix1::new(0.0));
         let theirs = m.innovations(&y, solve);
-        let moved = m.update((y.dot(&solve(&y)), &theirs), (&k_q, &k_v));
+        let moved = m.update((y.dot(&solve(&y)), &theirs), (&k_q, &k_v), true);
         // the alternative's innovation is 0: it becomes the state, moved
         // by (I − K H) of its offset
         assert!((moved.0[0] - 0.5).abs() < 1e-15);
@@ -358,6 +433,47 @@ mod tests {
         assert_eq!(m.len(), 1);
         let ((dq, _), gained) = m.merge_close(&Blocks::identity());
         assert!(m.is_empty() && dq[0].abs() < 1e-21 && gained.trace() < 1e-21);
+    }
+
+    /// An alternative held in reserve (`push_open`) is not in the mean; a
+    /// sample the state's law explains does not weigh it; one it fails
+    /// does, and makes it the state; it is never joined, only dropped once
+    /// light or once its hop has ended.
+    #[test]
+    fn a_law_in_reserve_counts_only_where_the_state_fails() {
+        let solve = |x: &Vector1<f64>| x / 0.01;
+        let (k_q, k_v) = (Matrix1::new(0.5), Matrix1::new(0.0));
+        let reserve = |lands: f64| {
+            let mut m = Mixture::<f64, 1>::empty();
+            m.push_open((Vector1::new(1.0), Vector1::new(0.0)), 0.0, lands);
+            m
+        };
+        let mut m = reserve(1.0);
+        assert_eq!(m.mean(), no_offset());
+        assert_eq!(m.spread().trace(), 0.0);
+        // a sample at the reserve's position: not weighed where the
+        // state's law is not refused, weighed and taken where it is
+        let y = Vector1::new(1.0);
+        let theirs = m.innovations(&y, solve);
+        let own = y.dot(&solve(&y));
+        let moved = m.update((own, &theirs), (&k_q, &k_v), false);
+        assert_eq!((moved, m.len()), (no_offset(), 1));
+        let moved = reserve(1.0).update((own, &theirs), (&k_q, &k_v), true);
+        assert!((moved.0[0] - 0.5).abs() < 1e-15);
+        // within a deviation, it is not joined; light, it is dropped
+        let ((dq, _), gained) = m.merge_close(&Blocks::identity().scaled(100.0));
+        assert_eq!((m.len(), dq[0], gained.trace()), (1, 0.0, 0.0));
+        let mut light = Mixture::<f64, 1>::empty();
+        light.push_open((Vector1::new(1.0), Vector1::new(0.0)), -10.0, 1.0);
+        let (_, gained) = light.merge_close(&Blocks::identity());
+        assert_eq!((light.len(), gained.trace()), (0, 0.0));
+        // its hop over, it is dropped; a step of the plant stays
+        m.push((Vector1::new(2.0), Vector1::new(0.0)), 0.0);
+        m.drop_open(0.5);
+        assert_eq!(m.len(), 2);
+        m.drop_open(1.0);
+        assert_eq!(m.len(), 1);
+        assert!(!m.is_open(0) && m.offset(0).0[0] == 2.0);
     }
 
     /// A step whose weight falls under [`PRUNE`] of the state's joins it

@@ -793,6 +793,10 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     /// The steps a plant may have taken a recent impact into, beside the
     /// one the state holds (module `mixture`; empty without a plant).
     mixture: Mixture<T, N>,
+    /// When each constraint was last seen open or struck at a sample (the
+    /// sample's time): how long the contacts held since have been
+    /// (module `propagate`, "A contact that may hover").
+    held_since: SVector<T, K>,
     /// `P` plus the spread of the mixture's means: the covariance of the
     /// estimate the filter reports.
     reported: Blocks<T, N>,
@@ -872,6 +876,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             sample: q0,
             fresh: true,
             mixture: Mixture::empty(),
+            held_since: SVector::repeat(t0),
             reported: p0,
         })
     }
@@ -1196,6 +1201,10 @@ where
         // (a sample that one of the steps a plant may have taken a recent
         // impact into explains is no outlier: module `mixture`)
         let mut mixture = propagation.mixture;
+        // a hovering contact whose hop has ended by this sample: its
+        // offset, carried by the free flow, no longer stands for it
+        // (module `propagate`, "A contact that may hover")
+        mixture.drop_open(t);
         let theirs = mixture.innovations(&y, |x| chol.solve(x));
         let gated = mixture.least_nis(nis, &theirs);
         let (q_new, v_new) = if gated > gate && !kalman.inflated {
@@ -1213,7 +1222,7 @@ where
             let (dq, dv) = if mixture.is_empty() {
                 (SVector::zeros(), SVector::zeros())
             } else {
-                let (dq, dv) = mixture.update((nis, &theirs), (&k_q, &k_v));
+                let (dq, dv) = mixture.update((nis, &theirs), (&k_q, &k_v), nis > gate);
                 // those the samples cannot tell from the state join it
                 let ((mq, mv), gained) = mixture.merge_close(&p);
                 p = p.add(&gained);
@@ -1242,6 +1251,11 @@ where
         }
         (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
         self.mixture = mixture;
+        for i in 0..K {
+            if !propagation.held.contains(i) || report.impacted.contains(i) {
+                self.held_since[i] = t;
+            }
+        }
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
         self.reported = if mixture.is_empty() {
             p
@@ -1353,7 +1367,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             (self.t, interval.tau),
             &self.params,
             (self.p, self.mixture),
-        );
+        )
+        .with_held_since(self.held_since, self.params.measurement);
         if self.fresh {
             propagation = propagation.relinearised((self.q - q, v0 - w));
         }
@@ -1409,6 +1424,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         report.outliers = self.screen.accept();
         (self.t, self.q, self.v, self.p) = (t, q, v, p);
         (self.mixture, self.reported) = (Mixture::empty(), p);
+        self.held_since = SVector::repeat(t);
         (self.sample, self.fresh) = (q, true);
         (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
         Self::estimate(self)
