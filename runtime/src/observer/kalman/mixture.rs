@@ -198,9 +198,30 @@ impl<T: RealField + Copy, const N: usize> Mixture<T, N> {
         self.lands[to] = self.lands[from];
     }
 
-    /// Whether alternative `a` has a contact open that the state holds.
-    pub fn is_open(&self, a: usize) -> bool {
-        self.open[a]
+    /// The offsets of the alternatives held in reserve
+    /// ([`Mixture::push_open`]; `None` in the other slots), or `None`
+    /// where there is none.
+    pub fn open_offsets(&self) -> Option<[Option<Offset<T, N>>; ALTERNATIVES]> {
+        if !self.open[..self.len].contains(&true) {
+            return None;
+        }
+        Some(core::array::from_fn(|a| {
+            (a < self.len && self.open[a]).then_some(self.offsets[a])
+        }))
+    }
+
+    /// Puts back the offsets `saved` by [`Mixture::open_offsets`], each
+    /// carried by `map` where one is given.
+    pub fn restore_open(
+        &mut self,
+        saved: &[Option<Offset<T, N>>; ALTERNATIVES],
+        map: Option<&Blocks<T, N>>,
+    ) {
+        for (a, offset) in saved.iter().enumerate() {
+            if let Some((q, v)) = offset {
+                self.offsets[a] = map.map_or((*q, *v), |m| m.apply(q, v));
+            }
+        }
     }
 
     /// Carries every offset through the linear map `map` (a piece's
@@ -473,7 +494,7 @@ mod tests {
         assert_eq!(m.len(), 2);
         m.drop_open(1.0);
         assert_eq!(m.len(), 1);
-        assert!(!m.is_open(0) && m.offset(0).0[0] == 2.0);
+        assert!(m.open_offsets().is_none() && m.offset(0).0[0] == 2.0);
     }
 
     /// A step whose weight falls under [`PRUNE`] of the state's joins it

@@ -1367,8 +1367,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             (self.t, interval.tau),
             &self.params,
             (self.p, self.mixture),
-        )
-        .with_held_since(self.held_since, self.params.measurement);
+            Some(self.held_since),
+        );
         if self.fresh {
             propagation = propagation.relinearised((self.q - q, v0 - w));
         }

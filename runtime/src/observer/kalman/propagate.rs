@@ -273,10 +273,11 @@ where
     /// The steps a plant may have taken an impact into, beside the
     /// predicted one (module `mixture`): offsets carried as `offset` is.
     pub mixture: Mixture<T, N>,
-    /// When each constraint was last seen open or struck at a sample, and
-    /// the measurement noise `R` (`None`: no law's alternative is kept;
-    /// [`Propagation::with_held_since`]).
-    held_since: Option<(SVector<T, K>, SMatrix<T, N, N>)>,
+    /// When each constraint was last seen open or struck at a sample
+    /// (`None`: no law is kept in reserve; module docs, "A contact that
+    /// may hover"), and the measurement noise `R`.
+    held_since: Option<SVector<T, K>>,
+    measurement: SMatrix<T, N, N>,
     /// Whether an impact may still split the prediction
     /// ([`KalmanParams::plant_step_mixture`] set, and none split yet in
     /// this interval).
@@ -297,13 +298,17 @@ where
     M: Sensitivities<N, K, Scalar = T>,
 {
     /// Follows `p` from `t0` over an interval of length `length` under the
-    /// noise of `params`.
+    /// noise of `params`; `held_since`, when each constraint was last seen
+    /// open or struck at a sample, lets a law that holds a contact beside
+    /// an impact keep the one in which it hovered in reserve (module docs,
+    /// "A contact that may hover").
     pub fn new(
         model: &'a M,
         u: &'a M::Input,
         (t0, length): (T, T),
         params: &KalmanParams<T, N>,
         (p, mixture): (Blocks<T, N>, Mixture<T, N>),
+        held_since: Option<SVector<T, K>>,
     ) -> Self {
         let square = |x: T| x * x;
         // the samples lie on the plant's grid where the interval is a
@@ -337,24 +342,13 @@ where
             offset: (SVector::zeros(), SVector::zeros()),
             carry: params.impact_delay != T::zero() || params.plant.is_some(),
             mixture,
-            held_since: None,
+            held_since,
+            measurement: params.measurement,
             may_split: params.plant_step_mixture,
             cross: None,
             saltations: 0,
             projections: 0,
             held: IndexSet::EMPTY,
-        }
-    }
-
-    /// The same propagation, told when each constraint was last seen open
-    /// or struck at a sample (`since`) and the measurement noise `R`: a law
-    /// that holds a contact beside an impact keeps the outcome in which
-    /// that contact hovers, where it may (module docs, "A contact that may
-    /// hover").
-    pub fn with_held_since(self, since: SVector<T, K>, measurement: SMatrix<T, N, N>) -> Self {
-        Self {
-            held_since: Some((since, measurement)),
-            ..self
         }
     }
 
@@ -373,7 +367,7 @@ where
     /// hop ends before the interval does (the free flow that carries the
     /// outcome's offset no longer describes it at the sample).
     fn may_hover(&self, jump: &Jump<'_, T, N, K>, dv: &SVector<T, N>) -> Option<(T, T)> {
-        let (since, measurement) = self.held_since.as_ref()?;
+        let (since, measurement) = (self.held_since.as_ref()?, &self.measurement);
         let t = self.t0 + jump.s;
         let (half, two): (T, T) = (nalgebra::convert(0.5), nalgebra::convert(2.0));
         let w = jump.w_plus + dv;
@@ -803,10 +797,11 @@ where
         self.held = held;
         // an alternative with a contact open that the state holds flies
         // free, not along the contact (carried again below)
-        let open: [Option<Offset<T, N>>; ALTERNATIVES] = core::array::from_fn(|a| {
-            (!held.is_empty() && a < self.mixture.len() && self.mixture.is_open(a))
-                .then(|| self.mixture.offset(a))
-        });
+        let open = if held.is_empty() {
+            None
+        } else {
+            self.mixture.open_offsets()
+        };
         let noise = white_noise(&SMatrix::from_diagonal(&self.density), piece.h);
         let mut p = flown.add(&noise);
         self.carry_offset(&phi);
@@ -867,14 +862,10 @@ where
                 across * noise.vv * across.transpose(),
             ));
         }
-        if open.iter().any(Option::is_some) {
+        if let Some(open) = open {
             let (a_free, _) = flow_jacobian(self.model, t, piece.p0, &w0, self.u)?;
             let phi_free = flow_transition(&a_free, piece.h);
-            for (a, offset) in open.iter().enumerate() {
-                if let Some((dq, dv)) = offset {
-                    self.mixture.set_offset(a, phi_free.apply(dq, dv));
-                }
-            }
+            self.mixture.restore_open(&open, Some(&phi_free));
         }
         self.p = p.symmetrized();
         Ok(())
@@ -985,15 +976,14 @@ where
         // a closure with no bounce is the state's contact: an alternative
         // that has it open does not meet it
         let plastic = jump.elastic.intersection(active).is_empty();
-        let open: [Option<Offset<T, N>>; ALTERNATIVES] = core::array::from_fn(|a| {
-            (plastic && a < self.mixture.len() && self.mixture.is_open(a))
-                .then(|| self.mixture.offset(a))
-        });
+        let open = if plastic {
+            self.mixture.open_offsets()
+        } else {
+            None
+        };
         self.carry_offset(&map);
-        for (a, offset) in open.iter().enumerate() {
-            if let Some(offset) = offset {
-                self.mixture.set_offset(a, *offset);
-            }
+        if let Some(open) = open {
+            self.mixture.restore_open(&open, None);
         }
         if let Some(on_grid) = on_grid {
             self.offset.0 += on_grid.offset.0;
