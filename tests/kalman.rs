@@ -2202,8 +2202,8 @@ moreau::model! {
 /// three samples; 0 to 10 samples a run skipped by the gate. With the held
 /// law alone (the code before the reserve): 0.020 to 0.310 m/s, above 0.15
 /// on starts 2, 6 and 7 (0.211, 0.222 and 0.310), and 0.222 on start 6's
-/// three samples, which the gate skipped (26 samples skipped on that
-/// start). The reserve made start 0 worse, 0.035 to 0.090 m/s.
+/// three samples, two of which the gate skipped (26 samples skipped on
+/// that start). The reserve made start 0 worse, 0.035 to 0.090 m/s.
 #[test]
 fn a_box_rocking_onto_a_corner_keeps_the_other_law_in_reserve() {
     let model = RockingBox::<f64>::default();

@@ -68,8 +68,8 @@
 //! `a_box_rocking_onto_a_corner_keeps_the_other_law_in_reserve`): one
 //! corner struck at 0.41 m/s beside the other, which micro-bounced 16 µm
 //! up, sends the plant's box to 0.32 rad/s and the held law's to 0.79
-//! rad/s the other way; the gate then skipped the three samples that said
-//! so.
+//! rad/s the other way, and the filter stayed that far off for three
+//! samples, the gate skipping two of them.
 //!
 //! So where the law held a contact that its force pressed on along the
 //! piece before, beside an elastic impact, the interval also computes the
