@@ -551,6 +551,10 @@ struct Path<const K: usize> {
     touched: IndexSet<K>,
     /// Held along the piece that led here: closed as well.
     held: IndexSet<K>,
+    /// Those of `held` that their contact force pressed on along that
+    /// piece: contacts that may hover a hair above their constraint,
+    /// unlike bodies glued with no force (`Interval::unheld`).
+    pressed: IndexSet<K>,
     /// Given an elastic impulse (a bounce) earlier in the interval, or an
     /// impulse in the last update's interval: constraints that may have
     /// just bounced.
@@ -1202,6 +1206,7 @@ where
             touched,
             held,
             bounced,
+            ..
         } = path;
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
         let mut c = Classes::default();

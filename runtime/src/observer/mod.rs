@@ -257,8 +257,9 @@
 //! the next impact's impulse drives in again: it is shut, its bounce
 //! cannot come later at the same point, and it joins that impact. Both
 //! come from a gripper whose two fingertips, on one finger coordinate,
-//! strike a table (the Panda's fingers free of their limits, a throw-away
-//! run): one at a time, a fingertip was left approaching and was held as
+//! strike a table (the Panda's fingers free of their limits,
+//! `tests/robots/kalman.rs`, `fingertips_striking_a_table_together_take_one_law`):
+//! one at a time, a fingertip was left approaching and was held as
 //! a persistent contact, flown 2 mm into the table, and the filter was
 //! up to 45 rad/s off.
 //!

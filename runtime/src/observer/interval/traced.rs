@@ -41,14 +41,23 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Flight<'_, T, N, K> {
     /// lies on, for the filter's projection and for reading a sample
     /// ([`Interval::read_on_contacts`]).
     pub(crate) fn held(&self) -> IndexSet<K> {
-        let mut held = IndexSet::EMPTY;
-        for i in self.sliding {
-            if self.impulse[i] > T::zero() || self.resting.contains(i) {
-                held.insert(i);
-            }
-        }
-        held
+        pressed(self.sliding, self.impulse).union(self.sliding.intersection(self.resting))
     }
+}
+
+/// Those of `sliding` that their contact force pressed on along a piece:
+/// a positive impulse `∫ λ ds`.
+fn pressed<T: RealField + Copy, const K: usize>(
+    sliding: IndexSet<K>,
+    impulse: &SVector<T, K>,
+) -> IndexSet<K> {
+    let mut pressed = IndexSet::EMPTY;
+    for i in sliding {
+        if impulse[i] > T::zero() {
+            pressed.insert(i);
+        }
+    }
+    pressed
 }
 
 /// One application of Newton's law at local time `s`, configuration `p`:
@@ -77,14 +86,14 @@ pub(crate) struct Jump<'a, T: RealField + Copy, const N: usize, const K: usize> 
     /// `M(p)` factored and the free acceleration at `(s, p, w⁻)`.
     pub free: &'a Free<T, N>,
     /// Where the law held some of the set as contacts (closed, met with
-    /// no restitution) beside a fast impact: how much the velocity after
-    /// it would differ, `w⁺_free − w⁺`, had those contacts been a hair
-    /// open, so that each bounces on its own when the impact drives it
-    /// in ([`Interval::unheld`]). `None` where none of the set is a
-    /// contact that its force pressed on along the piece before, where the
-    /// two agree within the estimate's velocity noise, or where the tracer
-    /// does not ask ([`Tracer::ALTERNATIVE`]).
-    pub alternative: Option<SVector<T, N>>,
+    /// no restitution) that their force pressed on along the piece before,
+    /// beside a fast impact: those contacts, and how much the velocity
+    /// after the law would differ, `w⁺_free − w⁺`, had they been a hair
+    /// open, so that each bounces on its own when the impact drives it in
+    /// ([`Interval::unheld`]). `None` where there is no such contact, where
+    /// the two agree within the estimate's velocity noise, or where the
+    /// tracer does not ask ([`Tracer::ALTERNATIVE`]).
+    pub alternative: Option<(IndexSet<K>, SVector<T, N>)>,
 }
 
 /// What follows the predicted motion of an interval, piece by piece.
@@ -197,9 +206,10 @@ where
 
     /// The velocity change by which the law's outcome `w_plus` at `at` on
     /// `set` (`ê` on `elastic`, none on the rest) would differ had the
-    /// contacts of the set met with no restitution been a hair open: the
-    /// set met one constraint at a time, the fastest approach first, each
-    /// with its own restitution ([`one_at_a_time`](Interval::one_at_a_time)).
+    /// contacts `hovering` of the set been a hair open: the set met one
+    /// constraint at a time, the fastest approach first, the elastic and
+    /// the hovering ones each with its own restitution
+    /// ([`one_at_a_time`](Interval::one_at_a_time)).
     ///
     /// The contact rule holds a closed constraint that its samples cannot
     /// tell from one that hovers within the noise, and the two laws part
@@ -209,21 +219,17 @@ where
     /// filter keeps this outcome in reserve (module docs of
     /// `runtime/src/observer/kalman/propagate.rs`, "A contact that may
     /// hover").
-    /// `None` where no such contact took part, or where the two agree
-    /// within the estimate's velocity noise on every constraint of the
-    /// set.
+    /// `None` where the two agree within the estimate's velocity noise on
+    /// every constraint of the set.
     fn unheld(
         &self,
         at: &Contact<'_, T, N, K>,
-        (set, elastic): (IndexSet<K>, IndexSet<K>),
+        (set, elastic, hovering): (IndexSet<K>, IndexSet<K>, IndexSet<K>),
         w_plus: &SVector<T, N>,
         report: &UpdateReport<T, N, K>,
     ) -> Option<SVector<T, N>> {
-        if elastic.is_empty() || set.difference(elastic).is_empty() {
-            return None;
-        }
         let mut e = SVector::<T, K>::zeros();
-        for i in set {
+        for i in elastic.union(hovering) {
             e[i] = self.restitution[i];
         }
         let minv_jt = at.chol.solve(&at.jac.transpose());
@@ -258,19 +264,13 @@ where
         // rounds counted by the events that end them (an impact, a
         // crossing); a step that ends at `max_step` continues its round
         let mut round = 1;
-        // those of `path.held` that their force pressed along the piece
-        // (for a tracer that takes `Jump::alternative`)
-        let mut pressed = IndexSet::EMPTY;
-        let pushing = |sliding: IndexSet<K>, impulse: &SVector<T, K>| {
-            let mut pushed = IndexSet::EMPTY;
+        // `path.pressed`, only for a tracer that takes `Jump::alternative`
+        let pressed_for = |sliding: IndexSet<K>, impulse: &SVector<T, K>| {
             if R::ALTERNATIVE {
-                for i in sliding {
-                    if impulse[i] > T::zero() {
-                        pushed.insert(i);
-                    }
-                }
+                pressed(sliding, impulse)
+            } else {
+                IndexSet::EMPTY
             }
-            pushed
         };
         loop {
             let last_round = round >= max_rounds;
@@ -312,9 +312,10 @@ where
                 let lambda = report.impulses - before;
                 // (a contact pressed by its force along the piece before: it
                 // may hover a hair above; one glued with no force does not)
-                let hovering = set.difference(elastic).intersection(pressed);
-                let alternative = if R::ALTERNATIVE && !hovering.is_empty() {
-                    self.unheld(&at, (set, elastic), &w_plus, report)
+                let hovering = set.difference(elastic).intersection(path.pressed);
+                let alternative = if R::ALTERNATIVE && !hovering.is_empty() && !elastic.is_empty() {
+                    self.unheld(&at, (set, elastic, hovering), &w_plus, report)
+                        .map(|dv| (hovering, dv))
                 } else {
                     None
                 };
@@ -407,7 +408,7 @@ where
                     report.impulses += part.impulse;
                     (s, p, w) = (s + at, part.p, part.w);
                     (resolved, path.touched, path.held) = (IndexSet::EMPTY, set, c.sliding);
-                    pressed = pushing(c.sliding, &part.impulse);
+                    path.pressed = pressed_for(c.sliding, &part.impulse);
                     round += 1;
                     continue;
                 }
@@ -431,7 +432,7 @@ where
             // classified again, without counting as a round
             (s, p, w) = (s + rest, arc.p, arc.w);
             (resolved, path.touched, path.held) = (IndexSet::EMPTY, IndexSet::EMPTY, c.sliding);
-            pressed = pushing(c.sliding, &arc.impulse);
+            path.pressed = pressed_for(c.sliding, &arc.impulse);
         }
     }
 }

@@ -352,8 +352,9 @@ where
         }
     }
 
-    /// The probability that a contact of `jump` that its law held (met
-    /// with no restitution) hovers a hair above its constraint, unseen, and
+    /// The probability that one of the contacts `hovering` that the law of
+    /// `jump` held (met with no restitution, pressed on by their force)
+    /// hovers a hair above its constraint, unseen, and
     /// when its hop in the outcome `w⁺ + dv` ends (module docs, "A contact
     /// that may hover"). The probability is half, the samples not telling
     /// resting from hovering, times the chance that a hidden run of
@@ -366,13 +367,17 @@ where
     /// that `Δ` is. `None` where no held contact may hover, or where its
     /// hop ends before the interval does (the free flow that carries the
     /// outcome's offset no longer describes it at the sample).
-    fn may_hover(&self, jump: &Jump<'_, T, N, K>, dv: &SVector<T, N>) -> Option<(T, T)> {
+    fn may_hover(
+        &self,
+        jump: &Jump<'_, T, N, K>,
+        (hovering, dv): (IndexSet<K>, &SVector<T, N>),
+    ) -> Option<(T, T)> {
         let (since, measurement) = (self.held_since.as_ref()?, &self.measurement);
         let t = self.t0 + jump.s;
         let (half, two): (T, T) = (nalgebra::convert(0.5), nalgebra::convert(2.0));
         let w = jump.w_plus + dv;
         let mut likeliest: Option<(T, T)> = None;
-        for i in jump.set.difference(jump.elastic) {
+        for i in hovering {
             let row = jump.jac.row(i);
             let g = row.norm();
             let press = -row.dot(&jump.free.accel.transpose()) / g;
@@ -1030,7 +1035,7 @@ where
         // its outcome kept in reserve (module docs)
         if let Some((dv, (p, lands))) = jump
             .alternative
-            .and_then(|dv| Some((dv, self.may_hover(jump, &dv)?)))
+            .and_then(|(hovering, dv)| Some((dv, self.may_hover(jump, (hovering, &dv))?)))
         {
             let offset = (SVector::zeros(), dv);
             self.mixture
