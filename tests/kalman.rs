@@ -2273,6 +2273,86 @@ fn a_box_rocking_onto_a_corner_keeps_the_other_law_in_reserve() {
     }
 }
 
+moreau::model! {
+    /// Example 1 with plastic impacts (`e = 0`): the mass stops on the
+    /// parabola at its first impact and slides along it from then on,
+    /// swinging as a pendulum does in a bowl. Written for
+    /// `a_plastic_impact_leaves_the_slide_where_the_plant_put_it`.
+    pub struct PlasticParabola;
+    coordinates { x: vx, y: vy }
+    parameters { m: 1.0, g: 9.81, c: 8.0 }
+    kinetic = 0.5 * m * (vx^2 + vy^2);
+    potential = m * g * y;
+    constraints { floor: y - x^2 >= 0, ceiling: c - y >= 0 }
+    restitution = 0.0;
+}
+
+moreau::model! {
+    /// A two-link arm (point masses at the ends of unit links, absolute
+    /// angles from the downward vertical, damped joints) whose tip leans
+    /// on the wall `x = 0.5`, which its hanging pose would cross; impacts
+    /// are plastic. Struck against the wall, the tip stays on it, pressed
+    /// by gravity, while the elbow swings. Written for
+    /// `a_plastic_impact_leaves_the_slide_where_the_plant_put_it`.
+    pub struct LeaningArm;
+    coordinates { th1: w1, th2: w2 }
+    parameters { m1: 1.0, m2: 1.0, l1: 1.0, l2: 1.0, g: 9.81, b: 0.05 }
+    kinetic = 0.5 * (m1 + m2) * l1^2 * w1^2 + 0.5 * m2 * l2^2 * w2^2
+        + m2 * l1 * l2 * w1 * w2 * cos(th1 - th2);
+    potential = -(m1 + m2) * g * l1 * cos(th1) - m2 * g * l2 * cos(th2);
+    applied { th1: -b * w1 + b * (w2 - w1), th2: -b * (w2 - w1) }
+    constraints { wall: l1 * sin(th1) + l2 * sin(th2) >= 0.5 }
+    restitution = 0.0;
+}
+
+/// A plastic impact leaves the plant where its step put it, and the
+/// filter holds the contact there (module docs of
+/// `runtime/src/observer/kalman/level.rs`). A time-stepping plant stops a
+/// body struck plastically inside the constraint, about `0.63 τ |ḣ|`
+/// deep (94 µm at 15 m/s), and slides it along that level set: Example 1
+/// with `e = 0` ([`PlasticParabola`]), held at `h = 0`, had the filter's
+/// velocity 1e-4 to 4e-4 m/s off all along the slide.
+///
+/// The issue's numbers, as for the models of
+/// `the_issues_numbers_hold_on_models_written_for_the_test` (plant at `τ =
+/// 1e-5`, 1 kHz, `σ = 1e-4`, `v̂(0) = 0`, defaults, scored over `[2, 10]`
+/// s; the same assertions: median within 3e-5, 90th percentile within
+/// 4e-4, maximum off the bracketing samples within 1e-2, exact-sample
+/// median within 1e-8, (38) within 0.1 off the brackets, no restart or
+/// refusal, under 1 % skipped), on eight drawn starts of each of two
+/// plastic models: [`PlasticParabola`] (Example 1's random starts, seed
+/// 2029) and [`LeaningArm`] (seed 2029: both angles uniform in [−1.5,
+/// 1.5] rad with the tip right of the wall, both rates in [−3, 3] rad/s).
+///
+/// Measured: on the parabola, filter medians 5.0e-6 to 2.0e-5, 90th
+/// percentiles 1.3e-5 to 4.2e-5, maxima off the brackets 1.8e-5 to 2.3e-4,
+/// exact-sample medians 2.3e-10 to 3.6e-9; on the arm, medians 5.0e-6 to
+/// 1.3e-5, exact-sample medians 5.8e-11 to 2.9e-10; the issue's 90th
+/// percentile met on all 16. With every contact held at `h = 0` (the code
+/// before the levels, run by a scratch copy of this test without its
+/// assertions): on the parabola, medians 9.1e-6 to 2.2e-4 (over 3e-5 on
+/// six of the eight), 90th percentiles up to 7.5e-4, exact-sample medians
+/// 2.4e-6 to 7.6e-5 (1 324 of the exact samples skipped by the gate on
+/// start 0); on the arm, the noisy figures within 30 % of today's, and
+/// exact-sample medians 3.8e-9 to 2.6e-6, over 1e-8 on six of the eight.
+#[test]
+fn a_plastic_impact_leaves_the_slide_where_the_plant_put_it() {
+    let parabola = random_example_1_starts(2029, 8);
+    let model = LeaningArm::<f64>::default();
+    let mut g = Gauss::new(2029);
+    let mut arm = Vec::new();
+    while arm.len() < 8 {
+        let q = Vector2::new(3.0 * g.uniform() - 1.5, 3.0 * g.uniform() - 1.5);
+        let v = Vector2::new(6.0 * g.uniform() - 3.0, 6.0 * g.uniform() - 3.0);
+        if model.gaps(&q)[0] > 0.0 {
+            arm.push((q, v));
+        }
+    }
+    let met = issues_numbers_on(&PlasticParabola::<f64>::default(), &parabola)
+        + issues_numbers_on(&model, &arm);
+    eprintln!("plastic impacts: the issue's 90th percentile (2e-4) met on {met} of 16 runs");
+}
+
 /// What [`run_counting`] saw: the figures over its window, the restarts
 /// (`UpdateReport::restart`) and the samples refused as outliers.
 struct Counted {
@@ -2540,7 +2620,12 @@ fn a_held_contact_does_no_work_on_a_separating_estimate() {
 /// m²), is stepped to the next sample, so its update is the prediction
 /// (its energy `½|v|² + g y` moves by the rounding and the Runge–Kutta
 /// truncation only, unless the prediction puts energy in). Asserted: no
-/// rise above 1e-7 J/kg. Measured: at most 2.2e-9 J/kg; before held
+/// rise above 1e-7 J/kg. Measured: at most 2.3e-8 J/kg (seed 555, start
+/// 6, at 8.273 s; 2.2e-9 before the held contacts' levels, module docs of
+/// `runtime/src/observer/kalman/level.rs`: the filter started from the
+/// running one's estimate does not have that filter's levels and holds
+/// its contacts at the surface, which lifts an estimate held below it; my
+/// reading, not traced: `g` times 2.3e-9 m is the gain); before held
 /// contacts were settled at the start of a piece, 1.3e-4 J/kg (seed
 /// 555, start 6, at 5.302 s: the floor pushing on an estimate leaving
 /// it; see `a_held_contact_does_no_work_on_a_separating_estimate`).

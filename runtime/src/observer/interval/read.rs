@@ -10,10 +10,12 @@
 //! is deeper than the noise explains. [`Interval::read_on_contacts`] keeps
 //! the first and drops the second: each held constraint whose gap the
 //! sample shows closed by more than `d` deviations of the measurement along
-//! its normal (`h_i(q) < −d √(J_i R J_iᵀ)`) is read on the contact, the
-//! sample moved onto `h_V = 0` for that set `V` by the least-squares step
-//! `−J_Vᵀ (J_V J_Vᵀ)⁻¹ h_V`. A sample outside a held contact is left as it
-//! is: that is how the samples show a contact opening.
+//! its normal (`h_i(q) − ℓ_i < −d √(J_i R J_iᵀ)`, `ℓ_i` the level the
+//! contact is held at: `0` for the observers, the filter's own for it,
+//! module `kalman::level`) is read on the contact, the sample moved onto
+//! `h_V = ℓ_V` for that set `V` by the least-squares step `−J_Vᵀ (J_V
+//! J_Vᵀ)⁻¹ (h_V − ℓ_V)`. A sample outside a held contact is left as it is:
+//! that is how the samples show a contact opening.
 //!
 //! What each estimator does with a sample inside, unread:
 //! - the filter's projection onto the contact left its covariance almost
@@ -39,10 +41,11 @@ where
     M: Model<N, K, Scalar = T>,
 {
     /// The sample `q` read on the constraints of `held` that it lies
-    /// deeper inside than `deviations` standard deviations of the
-    /// measurement (covariance `measurement`) along their normals (see the
-    /// module docs); `q` itself when none does, when `deviations` is not
-    /// finite (no test), or when those normals are dependent.
+    /// deeper inside their levels `levels` than `deviations` standard
+    /// deviations of the measurement (covariance `measurement`) along
+    /// their normals (see the module docs); `q` itself when none does,
+    /// when `deviations` is not finite (no test), or when those normals are
+    /// dependent.
     ///
     /// # Errors
     ///
@@ -50,13 +53,14 @@ where
     pub(crate) fn read_on_contacts(
         &self,
         q: &SVector<T, N>,
-        held: IndexSet<K>,
+        (held, levels): (IndexSet<K>, &SVector<T, K>),
         (measurement, deviations): (&SMatrix<T, N, N>, T),
     ) -> Result<SVector<T, N>, T> {
         if held.is_empty() || !deviations.is_finite() {
             return Ok(*q);
         }
         let (h, jac) = self.contact(q)?;
+        let h = h - levels;
         let mut inside = IndexSet::<K>::EMPTY;
         for i in held {
             let row = jac.row(i);

@@ -61,7 +61,10 @@
 //!      projected onto the tangent space of the contact manifold at the
 //!      end of the piece (less the constraints the motion lifts off there:
 //!      no force and a separating acceleration and speed at the end, module
-//!      `propagate`), `h_S(q) = 0` and `J_S(q) v = 0`, linearised as
+//!      `propagate`), `h_S(q) = ℓ_S` and `J_S(q) v = 0` (`ℓ` the levels
+//!      the contacts are held at: `0`, the rigid surface, unless an
+//!      impact into the contact and the samples since put it deeper,
+//!      module `level`), linearised as
 //!      `J_S δq = 0` and `∂(J_S v)/∂q δq + J_S δv = 0`
 //!      ([`Sensitivities::jacobian_dq`]), in the metric of `M` (that of a
 //!      plastic impact): `P ← B P Bᵀ`, a congruence, so positive
@@ -100,7 +103,7 @@
 //!    prediction per update is what it costs).
 //! 2. **Read** the sample: one that lies deeper inside a contact held at
 //!    the predicted end than `√gate` deviations of the measurement along
-//!    its normal is read on the contact (moved onto `h_V = 0` by the
+//!    its normal is read on the contact (moved onto `h_V = ℓ_V` by the
 //!    least-squares step along the normals). The rigid model has no state
 //!    for that depth (a compliant contact under a steady force, a
 //!    time-stepping plant's drift along a curved constraint), and the
@@ -134,7 +137,10 @@
 //!    reweighed by its own innovation's likelihood and moved by
 //!    `(I − K H)`; the gate takes the smallest of their innovations; the
 //!    estimate is their mean and [`SaltationKalman::covariance`] holds
-//!    their spread ([`KalmanReport::alternatives`]).
+//!    their spread ([`KalmanReport::alternatives`]). The levels of the
+//!    contacts held at the end follow (module `level`): a contact struck
+//!    in the interval takes the depth a delayed impact leaves, and the
+//!    sample, when used, measures it by a scalar Kalman update.
 //!
 //! Every congruence `B P Bᵀ` above (flow, saltation, projection, Joseph
 //! update) adds on its diagonal what covers its own rounding
@@ -150,6 +156,7 @@
 
 mod blocks;
 mod grid;
+mod level;
 mod mixture;
 mod propagate;
 mod saltation;
@@ -172,6 +179,7 @@ use super::{
 };
 use crate::error::DataError;
 use crate::validate;
+use level::Levels;
 use mixture::Mixture;
 use propagate::Propagation;
 
@@ -797,6 +805,8 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     /// sample's time): how long the contacts held since have been
     /// (module `propagate`, "A contact that may hover").
     held_since: SVector<T, K>,
+    /// The gaps the held contacts are held at (module `level`).
+    levels: Levels<T, K>,
     /// `P` plus the spread of the mixture's means: the covariance of the
     /// estimate the filter reports.
     reported: Blocks<T, N>,
@@ -877,6 +887,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             fresh: true,
             mixture: Mixture::empty(),
             held_since: SVector::repeat(t0),
+            levels: Levels::surface(),
             reported: p0,
         })
     }
@@ -1131,7 +1142,7 @@ where
         // gate allows on the contact (`Interval::read_on_contacts`)
         let read = interval.read_on_contacts(
             q,
-            propagation.held,
+            (propagation.held, &self.levels.mean),
             (&self.params.measurement, self.params.gate.sqrt()),
         )?;
         // GATE the innovation (the report keeps the sample's own)
@@ -1256,6 +1267,25 @@ where
                 self.held_since[i] = t;
             }
         }
+        // the levels of the contacts held at the end, measured by the
+        // sample where it was used (module `level`; nothing to do where
+        // no contact is held now or was before, as in free flight)
+        if !(propagation.held.is_empty() && self.levels.at_surface()) {
+            let sample = if propagation.held.is_empty() || kalman.outlier {
+                None
+            } else {
+                Some(interval.contact(q)?)
+            };
+            let (delay, timing) = self.level_delay();
+            self.levels.follow(
+                propagation.held,
+                &propagation.struck,
+                (delay, timing),
+                sample
+                    .as_ref()
+                    .map(|(h, jac)| (h, jac, &self.params.measurement)),
+            );
+        }
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
         self.reported = if mixture.is_empty() {
             p
@@ -1331,6 +1361,20 @@ where
     Ok(released)
 }
 
+impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
+    /// The delay of an impact and the variance of its instant that the
+    /// level of a struck contact takes (module `level`): the filter's own,
+    /// [`KalmanParams::impact_delay`] and
+    /// [`KalmanParams::impact_time_sigma`]`²`, plus a plant's step's, `τ_p
+    /// / 2` and `τ_p² / 12` (its impacts land uniformly within a step).
+    fn level_delay(&self) -> (T, T) {
+        let (delay, sigma) = (self.params.impact_delay, self.params.impact_time_sigma);
+        let step = self.params.plant.map_or(T::zero(), |plant| plant.tau);
+        let (half, twelfth): (T, T) = (nalgebra::convert(0.5), nalgebra::convert(1.0 / 12.0));
+        (delay + step * half, sigma * sigma + step * step * twelfth)
+    }
+}
+
 /// A prediction: the predicted end `(q, v)` and the propagation that
 /// followed the covariance to it.
 type Predicted<'m, M, T, const N: usize, const K: usize> =
@@ -1367,7 +1411,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             (self.t, interval.tau),
             &self.params,
             (self.p, self.mixture),
-            Some(self.held_since),
+            (Some(self.held_since), self.levels.mean),
         );
         if self.fresh {
             propagation = propagation.relinearised((self.q - q, v0 - w));
@@ -1425,6 +1469,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         (self.t, self.q, self.v, self.p) = (t, q, v, p);
         (self.mixture, self.reported) = (Mixture::empty(), p);
         self.held_since = SVector::repeat(t);
+        self.levels = Levels::surface();
         (self.sample, self.fresh) = (q, true);
         (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
         Self::estimate(self)

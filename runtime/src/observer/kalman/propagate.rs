@@ -290,6 +290,11 @@ where
     /// The constraints held along the last piece (pushing), if it ended
     /// the interval: the contacts the predicted end lies on.
     pub held: IndexSet<K>,
+    /// The gaps the held contacts are held at (module `level`).
+    levels: SVector<T, K>,
+    /// The fastest approach `−J_i w⁻` of each constraint that took an
+    /// impulse at an impact of the interval (`0` where none did).
+    pub struck: SVector<T, K>,
 }
 
 impl<'a, M, T, const N: usize, const K: usize> Propagation<'a, M, T, N, K>
@@ -301,14 +306,15 @@ where
     /// noise of `params`; `held_since`, when each constraint was last seen
     /// open or struck at a sample, lets a law that holds a contact beside
     /// an impact keep the one in which it hovered in reserve (module docs,
-    /// "A contact that may hover").
+    /// "A contact that may hover"); a contact held along a piece is held
+    /// at its gap in `levels` (module `level`).
     pub fn new(
         model: &'a M,
         u: &'a M::Input,
         (t0, length): (T, T),
         params: &KalmanParams<T, N>,
         (p, mixture): (Blocks<T, N>, Mixture<T, N>),
-        held_since: Option<SVector<T, K>>,
+        (held_since, levels): (Option<SVector<T, K>>, SVector<T, K>),
     ) -> Self {
         let square = |x: T| x * x;
         // the samples lie on the plant's grid where the interval is a
@@ -349,6 +355,8 @@ where
             saltations: 0,
             projections: 0,
             held: IndexSet::EMPTY,
+            levels,
+            struck: SVector::zeros(),
         }
     }
 
@@ -825,8 +833,9 @@ where
                 self.offset.0 += dq * steps + dv * (steps * piece.h * half);
                 self.offset.1 += dv * steps;
             }
-            // onto the manifold h_S = 0, J_S v = 0 at the end of the piece:
-            // the covariance, and the state in the same metric
+            // onto the manifold h_S = ℓ_S, J_S v = 0 at the end of the
+            // piece (ℓ the contacts' levels, module `level`): the
+            // covariance, and the state in the same metric
             let (h, jac) = self.model.contact(piece.p1);
             let rate = self.model.jacobian_dq(piece.p1, piece.w1);
             validate::finite_model(&h, "h")?;
@@ -845,7 +854,15 @@ where
             let projection = if ends_on.is_empty() {
                 None
             } else {
-                project_onto_contact(&p, &mass, &h, &jac, &rate, piece.w1, ends_on)
+                project_onto_contact(
+                    &p,
+                    &mass,
+                    &(h - self.levels),
+                    &jac,
+                    &rate,
+                    piece.w1,
+                    ends_on,
+                )
             };
             if let Some(projection) = projection {
                 p = projection.p;
@@ -893,6 +910,10 @@ where
         }
         if active.is_empty() {
             return Ok(());
+        }
+        for i in active {
+            let approach = -jump.jac.row(i).dot(&jump.w_minus.transpose());
+            self.struck[i] = self.struck[i].max(approach);
         }
         self.held = IndexSet::EMPTY;
         // the impact time moves with the constraint whose root timed it

@@ -535,8 +535,9 @@ pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
 /// semi-definite, its own rounding covered by
 /// [`Blocks::congruence_covered`]). The state moves onto the
 /// manifold along the same metric: `δq = −J⁺ h_S`, then
-/// `δv = −J⁺ (J_S v + D δq)`. Returns `None` when the rows of `set` are
-/// dependent.
+/// `δv = −J⁺ (J_S v + D δq)`. `h` is the gap to the manifold: `h(q) − ℓ`
+/// for a contact held at the level `ℓ` (module `level`). Returns `None`
+/// when the rows of `set` are dependent.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K: usize>(
     p: &Blocks<T, N>,
