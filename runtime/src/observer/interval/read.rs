@@ -12,10 +12,13 @@
 //! sample shows closed by more than `d` deviations of the measurement along
 //! its normal (`h_i(q) − ℓ_i < −d √(J_i R J_iᵀ)`, `ℓ_i` the level the
 //! contact is held at: `0` for the observers, the filter's own for it,
-//! module `kalman::level`) is read on the contact, the sample moved onto
-//! `h_V = ℓ_V` for that set `V` by the least-squares step `−J_Vᵀ (J_V
-//! J_Vᵀ)⁻¹ (h_V − ℓ_V)`. A sample outside a held contact is left as it is:
-//! that is how the samples show a contact opening.
+//! module `kalman::level`) is read on the contact: the sample is moved
+//! onto `h_V = ℓ_V` for that set `V` by the least step that leaves the
+//! gaps of the other held contacts as they are, `−J_Sᵀ (J_S J_Sᵀ)⁻¹ g`
+//! with `g` the sample's `h_i − ℓ_i` on `V` and `0` on the rest of the
+//! held set `S` (along `V`'s normals alone where those of `S` are
+//! dependent). A sample outside a held contact is left as it is: that is
+//! how the samples show a contact opening.
 //!
 //! What each estimator does with a sample inside, unread:
 //! - the filter's projection onto the contact left its covariance almost
@@ -72,19 +75,30 @@ where
         if inside.is_empty() {
             return Ok(*q);
         }
-        // J_V J_Vᵀ on the rows and columns of `V`, the identity elsewhere
-        let mut gram = SMatrix::<T, K, K>::identity();
-        let mut gaps = SVector::<T, K>::zeros();
-        for i in inside.iter() {
-            gaps[i] = h[i];
-            for j in inside.iter() {
-                gram[(i, j)] = jac.row(i).dot(&jac.row(j));
+        // the least step that puts the sample on `h_V = ℓ_V` and leaves
+        // the other held gaps as they are (a step along the normals of
+        // `V` alone moves those too where the normals are not orthogonal,
+        // as a box's two corners' are: the sample then left a held corner
+        // by as much as it read the other on, and the gate skipped it); on
+        // `V` alone where the held normals are dependent
+        let step = |set: IndexSet<K>| {
+            // J_S J_Sᵀ on the rows and columns of `S`, the identity
+            // elsewhere
+            let mut gram = SMatrix::<T, K, K>::identity();
+            let mut gaps = SVector::<T, K>::zeros();
+            for i in set.iter() {
+                if inside.contains(i) {
+                    gaps[i] = h[i];
+                }
+                for j in set.iter() {
+                    gram[(i, j)] = jac.row(i).dot(&jac.row(j));
+                }
             }
-        }
-        let Some(chol) = nalgebra::linalg::Cholesky::new(gram) else {
+            nalgebra::linalg::Cholesky::new(gram).map(|chol| chol.solve(&gaps))
+        };
+        let Some(x) = step(held).or_else(|| step(inside)) else {
             return Ok(*q);
         };
-        let x = chol.solve(&gaps);
         Ok(q - jac.transpose() * x)
     }
 }
