@@ -2152,24 +2152,42 @@ where
     met
 }
 
-moreau::model! {
-    /// A uniform box, 0.4 m wide, 0.2 m high and 1 kg, on a frictionless
-    /// floor, each of its corners a constraint (`c1`, `c2` the top corners
-    /// when upright, `c3`, `c4` the bottom ones). Landing, it rocks from
-    /// corner to corner. Written for
+/// The boxes' model, written for their tests: a uniform box, 0.4 m wide,
+/// 0.2 m high and 1 kg, on a frictionless floor, each of its corners a
+/// constraint (`c1`, `c2` the top corners when upright, `c3`, `c4` the
+/// bottom ones), with the restitution `$e`.
+macro_rules! a_box {
+    ($(#[$doc:meta])* $name:ident, $e:tt) => {
+        moreau::model! {
+            $(#[$doc])*
+            pub struct $name;
+            coordinates { x: vx, y: vy, th: w }
+            parameters { m: 1.0, a: 0.2, b: 0.1, g: 9.81, i: 0.016666666666666666 }
+            kinetic = 0.5 * m * (vx^2 + vy^2) + 0.5 * i * w^2;
+            potential = m * g * y;
+            constraints {
+                c1: y + a * sin(th) + b * cos(th) >= 0,
+                c2: y - a * sin(th) + b * cos(th) >= 0,
+                c3: y + a * sin(th) - b * cos(th) >= 0,
+                c4: y - a * sin(th) - b * cos(th) >= 0,
+            }
+            restitution = $e;
+        }
+    };
+}
+
+a_box! {
+    /// The box of `a_box!` with `e = 0.8`: landing, it rocks from corner
+    /// to corner. Written for
     /// `a_box_rocking_onto_a_corner_keeps_the_other_law_in_reserve`.
-    pub struct RockingBox;
-    coordinates { x: vx, y: vy, th: w }
-    parameters { m: 1.0, a: 0.2, b: 0.1, g: 9.81, i: 0.016666666666666666 }
-    kinetic = 0.5 * m * (vx^2 + vy^2) + 0.5 * i * w^2;
-    potential = m * g * y;
-    constraints {
-        c1: y + a * sin(th) + b * cos(th) >= 0,
-        c2: y - a * sin(th) + b * cos(th) >= 0,
-        c3: y + a * sin(th) - b * cos(th) >= 0,
-        c4: y - a * sin(th) - b * cos(th) >= 0,
-    }
-    restitution = 0.8;
+    RockingBox, 0.8
+}
+
+a_box! {
+    /// [`RockingBox`] with plastic impacts (`e = 0`): dropped, it lands on
+    /// a corner, falls onto the next and rests on the two. Written for
+    /// `a_plastic_box_rests_on_two_corners_each_at_its_own_level`.
+    PlasticBox, 0.0
 }
 
 /// A box rocking onto a corner while the corner it rocks off micro-bounces
@@ -2338,24 +2356,6 @@ fn a_plastic_impact_leaves_the_slide_where_the_plant_put_it() {
     let met = issues_numbers_on(&PlasticParabola::<f64>::default(), &parabola)
         + issues_numbers_on(&model, &arm);
     eprintln!("plastic impacts: the issue's 90th percentile (2e-4) met on {met} of 16 runs");
-}
-
-moreau::model! {
-    /// [`RockingBox`] with plastic impacts (`e = 0`): dropped, it lands on
-    /// a corner, falls onto the next and rests on the two. Written for
-    /// `a_plastic_box_rests_on_two_corners_each_at_its_own_level`.
-    pub struct PlasticBox;
-    coordinates { x: vx, y: vy, th: w }
-    parameters { m: 1.0, a: 0.2, b: 0.1, g: 9.81, i: 0.016666666666666666 }
-    kinetic = 0.5 * m * (vx^2 + vy^2) + 0.5 * i * w^2;
-    potential = m * g * y;
-    constraints {
-        c1: y + a * sin(th) + b * cos(th) >= 0,
-        c2: y - a * sin(th) + b * cos(th) >= 0,
-        c3: y + a * sin(th) - b * cos(th) >= 0,
-        c4: y - a * sin(th) - b * cos(th) >= 0,
-    }
-    restitution = 0.0;
 }
 
 /// A box that lands plastically rests on two corners, each at its own
