@@ -1269,12 +1269,15 @@ where
         }
         // the levels of the contacts held at the end, measured by the
         // sample where it was used (module `level`; nothing to do where
-        // no contact is held now or was before, as in free flight)
+        // no contact is held now or was before, as in free flight). The
+        // state is written: a sample whose `h`, `J` the model cannot give
+        // (the read above evaluated them unless the gate is infinite)
+        // measures no level, and the update stands.
         if !(propagation.held.is_empty() && self.levels.at_surface()) {
             let sample = if propagation.held.is_empty() || kalman.outlier {
                 None
             } else {
-                Some(interval.contact(q)?)
+                interval.contact(q).ok()
             };
             let (delay, timing) = self.level_delay();
             self.levels.follow(
