@@ -24,8 +24,8 @@
 //!   contact rule makes at the end of micro-bounces), `ℓ_i = 0`, `s_i² =
 //!   0`: the rigid model's, and no sample moves it;
 //! - an impact into it at the approach speed `|ḣ|` adds the penetration
-//!   that a delayed impact leaves, `ℓ_i −= δ̄ |ḣ|` and `s_i² += σ_δ²
-//!   |ḣ|²`, with the delay and spread the filter already has for an
+//!   that a delayed impact leaves, `ℓ_i −= max(δ̄, 0) |ḣ|` and `s_i² +=
+//!   σ_δ² |ḣ|²`, with the delay and spread the filter already has for an
 //!   impact's instant
 //!   ([`KalmanParams::impact_delay`](super::KalmanParams::impact_delay)
 //!   and
@@ -36,7 +36,7 @@
 //!   `z_i = h_i(q)` with the variance `J_i R J_iᵀ`, by a scalar Kalman
 //!   update; the level is kept at or below `0` (a contact held open would
 //!   read as no contact) and no deeper than the impacts can have left it,
-//!   `−Σ (δ̄ + 3 σ_δ) |ḣ|`: the level is the trace of delayed impacts, not
+//!   `−Σ max(δ̄ + 3 σ_δ, 0) |ḣ|`: the level is the trace of delayed impacts, not
 //!   a model of a compliant contact, which samples pressed in by a steady
 //!   force would otherwise teach it (those are read on the contact,
 //!   [`Interval::read_on_contacts`](crate::observer::interval));
@@ -61,9 +61,9 @@ pub(crate) struct Levels<T: RealField + Copy, const K: usize> {
     /// `s_i²`.
     variance: SVector<T, K>,
     /// The deepest level the impacts into each contact can have left,
-    /// `−Σ (δ̄ + 3 σ_δ) |ḣ|`.
+    /// `−Σ max(δ̄ + 3 σ_δ, 0) |ḣ|`.
     deepest: SVector<T, K>,
-    /// The contacts held at the last sample the filter used.
+    /// The contacts held at the end of the last update.
     held: IndexSet<K>,
 }
 
@@ -78,8 +78,8 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
         }
     }
 
-    /// Whether no contact was held at the last sample the filter used
-    /// (every level then at the surface).
+    /// Whether no contact was held at the end of the last update (every
+    /// level then at the surface).
     pub fn at_surface(&self) -> bool {
         self.held.is_empty()
     }
@@ -96,7 +96,9 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
         (delay, timing): (T, T),
         sample: Option<(&SVector<T, K>, &SMatrix<T, K, N>, &SMatrix<T, N, N>)>,
     ) {
-        let reach = delay + timing.sqrt() * nalgebra::convert(3.0);
+        // (an early impact, `δ̄ < 0`, leaves nothing inside)
+        let late = delay.max(T::zero());
+        let reach = (delay + timing.sqrt() * nalgebra::convert(3.0)).max(T::zero());
         for i in 0..K {
             if !held.contains(i) || !self.held.contains(i) {
                 self.mean[i] = T::zero();
@@ -108,7 +110,7 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
             }
             let speed = struck[i];
             if speed > T::zero() {
-                self.mean[i] -= delay * speed;
+                self.mean[i] -= late * speed;
                 self.variance[i] += timing * speed * speed;
                 self.deepest[i] -= reach * speed;
             }
@@ -125,7 +127,7 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
                     self.variance[i] *= T::one() - gain;
                 }
             }
-            self.mean[i] = self.mean[i].min(T::zero()).max(self.deepest[i]);
+            self.mean[i] = self.mean[i].max(self.deepest[i]).min(T::zero());
         }
         self.held = held;
     }
@@ -207,5 +209,18 @@ mod tests {
             Some((&gap, &jac, &r)),
         );
         assert_eq!(levels.mean[0], 0.0);
+        // impacts early on average (a signed delay, as a tuned one may
+        // be): nothing inside, however deep the samples
+        let mut early = Levels::<f64, 1>::surface();
+        for k in 0..100 {
+            let speed = if k == 0 { 15.0 } else { 0.0 };
+            early.follow(
+                held,
+                &Vector1::new(speed),
+                (-2e-5, timing),
+                Some((&gap, &jac, &r)),
+            );
+            assert_eq!(early.mean[0], 0.0);
+        }
     }
 }
