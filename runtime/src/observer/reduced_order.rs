@@ -257,6 +257,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> ReducedOrder<T, N, K> 
                     let deviations = nalgebra::convert(SMOOTHING_GATE);
                     interval.read_on_contacts(
                         &interval.q1,
+                        None,
                         (events.held, &SVector::zeros()),
                         (&measurement, deviations),
                     )?

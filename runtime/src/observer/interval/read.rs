@@ -48,7 +48,8 @@ where
     /// deviations of the measurement (covariance `measurement`) along
     /// their normals (see the module docs); `q` itself when none does,
     /// when `deviations` is not finite (no test), or when those normals are
-    /// dependent.
+    /// dependent. `at_sample` is `(h(q), J(q))` where the caller has them
+    /// (evaluated here otherwise).
     ///
     /// # Errors
     ///
@@ -56,13 +57,17 @@ where
     pub(crate) fn read_on_contacts(
         &self,
         q: &SVector<T, N>,
+        at_sample: Option<&(SVector<T, K>, SMatrix<T, K, N>)>,
         (held, levels): (IndexSet<K>, &SVector<T, K>),
         (measurement, deviations): (&SMatrix<T, N, N>, T),
     ) -> Result<SVector<T, N>, T> {
         if held.is_empty() || !deviations.is_finite() {
             return Ok(*q);
         }
-        let (h, jac) = self.contact(q)?;
+        let (h, jac) = match at_sample {
+            Some(&contact) => contact,
+            None => self.contact(q)?,
+        };
         let h = h - levels;
         let mut inside = IndexSet::<K>::EMPTY;
         for i in held {

@@ -1139,11 +1139,20 @@ where
             ..KalmanReport::empty()
         };
         // READ a sample that lies deeper inside a held contact than the
-        // gate allows on the contact (`Interval::read_on_contacts`)
+        // gate allows on the contact (`Interval::read_on_contacts`); its
+        // `h`, `J`, evaluated once here where the read needs them, serve
+        // the levels below too
+        let deviations = self.params.gate.sqrt();
+        let at_sample = if propagation.held.is_empty() || !deviations.is_finite() {
+            None
+        } else {
+            Some(interval.contact(q)?)
+        };
         let read = interval.read_on_contacts(
             q,
+            at_sample.as_ref(),
             (propagation.held, &self.levels.mean),
-            (&self.params.measurement, self.params.gate.sqrt()),
+            (&self.params.measurement, deviations),
         )?;
         // GATE the innovation (the report keeps the sample's own)
         let y = read - q_pred;
@@ -1277,13 +1286,12 @@ where
             let sample = if propagation.held.is_empty() || kalman.outlier {
                 None
             } else {
-                interval.contact(q).ok()
+                at_sample.or_else(|| interval.contact(q).ok())
             };
-            let (delay, timing) = self.level_delay();
             self.levels.follow(
                 propagation.held,
                 &propagation.struck,
-                (delay, timing),
+                propagation.lateness(),
                 sample
                     .as_ref()
                     .map(|(h, jac)| (h, jac, &self.params.measurement)),
@@ -1362,20 +1370,6 @@ where
         released.insert(i);
     }
     Ok(released)
-}
-
-impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, K> {
-    /// The delay of an impact and the variance of its instant that the
-    /// level of a struck contact takes (module `level`): the filter's own,
-    /// [`KalmanParams::impact_delay`] and
-    /// [`KalmanParams::impact_time_sigma`]`²`, plus a plant's step's, `τ_p
-    /// / 2` and `τ_p² / 12` (its impacts land uniformly within a step).
-    fn level_delay(&self) -> (T, T) {
-        let (delay, sigma) = (self.params.impact_delay, self.params.impact_time_sigma);
-        let step = self.params.plant.map_or(T::zero(), |plant| plant.tau);
-        let (half, twelfth): (T, T) = (nalgebra::convert(0.5), nalgebra::convert(1.0 / 12.0));
-        (delay + step * half, sigma * sigma + step * step * twelfth)
-    }
 }
 
 /// A prediction: the predicted end `(q, v)` and the propagation that

@@ -410,6 +410,16 @@ where
         likeliest
     }
 
+    /// The mean delay of an impact and the variance of its instant, as
+    /// this propagation times impacts: `δ̄` plus half a plant's step (its
+    /// impacts land uniformly within a step), and `σ_t²` plus `τ_p²/12`.
+    /// The depth a struck contact is held at takes them (module `level`).
+    pub fn lateness(&self) -> (T, T) {
+        let half: T = nalgebra::convert(0.5);
+        let step = self.plant.map_or(T::zero(), |plant| plant.tau);
+        (self.delay + step * half, self.timing)
+    }
+
     /// The same propagation for a prediction linearised at a point other
     /// than the prior's mean: `deviation` (the prior's mean minus that
     /// point) is carried to the end as the offset is, so that the
