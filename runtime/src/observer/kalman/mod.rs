@@ -1288,13 +1288,22 @@ where
             } else {
                 at_sample.or_else(|| interval.contact(q).ok())
             };
+            let sample = sample
+                .as_ref()
+                .map(|(h, jac)| (h, jac, &self.params.measurement));
+            // a prediction the sample contradicted past the gate (the
+            // filter widened it) held the struck contacts at levels the
+            // plant has left: they start again from the sample
+            if kalman.inflated
+                && let Some(sample) = sample
+            {
+                self.levels.restart(propagation.held, sample);
+            }
             self.levels.follow(
                 propagation.held,
                 &propagation.struck,
                 propagation.lateness(),
-                sample
-                    .as_ref()
-                    .map(|(h, jac)| (h, jac, &self.params.measurement)),
+                sample,
             );
         }
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
