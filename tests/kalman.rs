@@ -4297,3 +4297,64 @@ fn exact_samples_keep_the_covariance_positive_in_f32() {
         assert!(seen.max <= 1e-2, "{label}: {:e}", seen.max);
     }
 }
+
+moreau::model! {
+    /// A unit point mass in the corner between the floor `y ≥ 0` and a
+    /// ramp `y ≥ −x` rising to the left, pushed toward the ramp by a
+    /// force that swells and fades, `f sin²(ω t / 2)` (up to one and a
+    /// half times its weight, over a period of 4π s); impacts are
+    /// plastic. Past its weight the push lifts the
+    /// mass off the floor and up the ramp while gravity alone still
+    /// presses it onto the floor: only the ramp's force pulls it away.
+    /// As the push fades the mass slides back down, strikes the floor and
+    /// slides along it until the push brings it back into the corner.
+    /// Written for `a_contact_that_another_contacts_force_pulls_away_lifts_off`.
+    pub struct RampCorner;
+    coordinates { x: vx, y: vy }
+    parameters { g: 9.81, f: 14.715, w: 0.5 }
+    kinetic = 0.5 * (vx^2 + vy^2);
+    potential = g * y;
+    applied { x: -f * sin(0.5 * w * t)^2 }
+    constraints { floor: y >= 0, ramp: y + x >= 0 }
+    restitution = 0.0;
+}
+
+/// A contact that only another contact's force pulls away lifts off when
+/// that force says so. [`RampCorner`] rests in the corner of a floor and
+/// a ramp until the push past its weight lifts it up the ramp, with
+/// gravity alone still pressing it onto the floor. The end of a held
+/// piece is projected only onto the contacts it still lies on
+/// (`lifted` in `runtime/src/observer/kalman/propagate.rs`); that test
+/// also asked the free motion alone to leave the contact, so the floor
+/// stayed held until the gate let it go, and the error reached 0.1 m/s
+/// off the bracketing samples (start 0, at the code before). A Franka
+/// Panda whose hand rests on a table while a joint sits at its limit
+/// lifts its hand the same way (a scratch run: 0.1 rad/s off, velocity
+/// NEES median 118, before; 0.041 and 1.6 after).
+///
+/// The issue's numbers, as for the models of
+/// `the_issues_numbers_hold_on_models_written_for_the_test`, on eight
+/// drawn starts on the floor right of the corner (seed 7: `x` uniform in
+/// [0, 0.3] m, `v_x` in [−0.5, 0] m/s), which the push brings into the
+/// corner and up the ramp.
+///
+/// Measured: filter medians 1.8e-6 to 2.8e-6 m/s, 90th percentiles 7.0e-6
+/// to 1.2e-5, maxima off the brackets 1.2e-5 to 4.0e-3; exact-sample
+/// medians 9.0e-12 to 9.3e-12 with 22 to 33 of the 10 001 exact samples
+/// skipped by the gate (1 940 on start 1 before a contradicted level
+/// started again from the sample: `Levels::restart` in
+/// `runtime/src/observer/kalman/level.rs`); (38) within 0.029.
+#[test]
+fn a_contact_that_another_contacts_force_pulls_away_lifts_off() {
+    let model = RampCorner::<f64>::default();
+    let mut g = Gauss::new(7);
+    let starts: Vec<_> = (0..8)
+        .map(|_| {
+            let q = Vector2::new(0.3 * g.uniform(), 0.0);
+            let v = Vector2::new(-0.5 * g.uniform(), 0.0);
+            (q, v)
+        })
+        .collect();
+    let met = issues_numbers_on(&model, &starts);
+    eprintln!("the ramp's corner: the issue's 90th percentile (2e-4) met on {met} of 8 runs");
+}
