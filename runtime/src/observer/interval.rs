@@ -766,7 +766,7 @@ where
     /// constraints ([`opposed`]), the constraints are met one at a time
     /// ([`one_at_a_time`](Self::one_at_a_time)), unless the set is met
     /// `together`: a fast impact beside a contact held along the piece
-    /// before it, or a set widened by a constraint its impulse turned
+    /// before it and not separating from it, or a set widened by a constraint its impulse turned
     /// back (`Interval::meet`), which a time-stepping plant's step meets
     /// with one law. The impulses recorded since `before` are those of
     /// the law kept, which is returned with `dv`.
