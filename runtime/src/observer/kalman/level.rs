@@ -88,10 +88,13 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
         self.held.is_empty()
     }
 
-    /// The levels of the struck contacts held before and after an update
+    /// The levels of the struck contacts `held` at the end of an update
     /// started again from its sample, `ℓ_i = h_i(q)` within its bounds,
     /// `s_i² = J_i R J_iᵀ` (`sample` as for [`Levels::follow`]), for an
-    /// update whose prediction the sample contradicted past the gate.
+    /// update whose prediction the sample contradicted past the gate;
+    /// called after [`Levels::follow`] (the sample then counts once, and
+    /// an impact of the interval is not added below the level the sample
+    /// measures after it).
     ///
     /// The plant may move a held contact's depth without striking it: an
     /// impact on another contact held with it (a mass struck into the
@@ -107,6 +110,7 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
         (h, jac, measurement): (&SVector<T, K>, &SMatrix<T, K, N>, &SMatrix<T, N, N>),
     ) {
         for i in held.intersection(self.held) {
+            // (`deepest < 0`: struck since it was last released)
             if self.deepest[i] < T::zero() && h[i].is_finite() {
                 let row = jac.row(i);
                 self.mean[i] = h[i].max(self.deepest[i]).min(T::zero());

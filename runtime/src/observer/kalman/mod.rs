@@ -1291,20 +1291,22 @@ where
             let sample = sample
                 .as_ref()
                 .map(|(h, jac)| (h, jac, &self.params.measurement));
-            // a prediction the sample contradicted past the gate (the
-            // filter widened it) held the struck contacts at levels the
-            // plant has left: they start again from the sample
-            if kalman.inflated
-                && let Some(sample) = sample
-            {
-                self.levels.restart(propagation.held, sample);
-            }
             self.levels.follow(
                 propagation.held,
                 &propagation.struck,
                 propagation.lateness(),
                 sample,
             );
+            // a prediction the sample contradicted past the gate (the
+            // filter widened it) held the struck contacts at levels the
+            // plant has left: they start again from the sample (after
+            // `follow`, so that the sample counts once and an impact in
+            // the interval is not added again below the level it measures)
+            if kalman.inflated
+                && let Some(sample) = sample
+            {
+                self.levels.restart(propagation.held, sample);
+            }
         }
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
         self.reported = if mixture.is_empty() {
