@@ -307,13 +307,11 @@ where
                 // before its wall, met with the floor took the arm's swing
                 // back through Newton's law on two nearly opposite
                 // gradients)
-                let jw = jac * w;
                 let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
-                let resting = path
-                    .held
-                    .intersection(c.contact)
-                    .iter()
-                    .any(|i| jw[i] <= roundoff * jac.row(i).norm());
+                let resting = path.held.intersection(c.contact).iter().any(|i| {
+                    let row = jac.row(i);
+                    row.dot(&w.transpose()) <= roundoff * row.norm()
+                });
                 let together = resting && !elastic.is_empty();
                 let Met {
                     w_plus,

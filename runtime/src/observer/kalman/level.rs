@@ -88,8 +88,9 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
         self.held.is_empty()
     }
 
-    /// The levels of the struck contacts `held` at the end of an update
-    /// started again from its sample, `ℓ_i = h_i(q)` within its bounds,
+    /// The levels of the struck contacts held at the end of an update
+    /// (those [`Levels::follow`] has just taken) started again from its
+    /// sample, `ℓ_i = h_i(q)` within its bounds,
     /// `s_i² = J_i R J_iᵀ` (`sample` as for [`Levels::follow`]), for an
     /// update whose prediction the sample contradicted past the gate;
     /// called after [`Levels::follow`] (the sample then counts once, and
@@ -106,10 +107,9 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
     /// `a_contact_that_another_contacts_force_pulls_away_lifts_off`).
     pub fn restart<const N: usize>(
         &mut self,
-        held: IndexSet<K>,
         (h, jac, measurement): (&SVector<T, K>, &SMatrix<T, K, N>, &SMatrix<T, N, N>),
     ) {
-        for i in held.intersection(self.held) {
+        for i in self.held {
             // (`deepest < 0`: struck since it was last released)
             if self.deepest[i] < T::zero() && h[i].is_finite() {
                 let row = jac.row(i);
@@ -285,16 +285,16 @@ mod tests {
         );
         assert_eq!(levels.mean[0], -1.2e-8);
         // restarted from it, it sits there
-        levels.restart(held, (&shallow, &jac, &exact));
+        levels.restart((&shallow, &jac, &exact));
         assert_eq!(levels.mean[0], -7.5e-10);
         // and no deeper than the impact can have left it, 3 σ_δ |ḣ| = 9e-8
-        levels.restart(held, (&Vector1::new(-1.0), &jac, &exact));
+        levels.restart((&Vector1::new(-1.0), &jac, &exact));
         assert!((levels.mean[0] + 9e-8).abs() <= 1e-20, "{}", levels.mean[0]);
         // held without an impact: the surface, restart or not
         let mut closed = Levels::<f64, 1>::surface();
         closed.follow::<2>(held, &Vector1::zeros(), (0.0, 9e-12), None);
         closed.follow::<2>(held, &Vector1::zeros(), (0.0, 9e-12), None);
-        closed.restart(held, (&deep, &jac, &exact));
+        closed.restart((&deep, &jac, &exact));
         assert_eq!(closed.mean[0], 0.0);
     }
 }

@@ -1305,7 +1305,7 @@ where
             if kalman.inflated
                 && let Some(sample) = sample
             {
-                self.levels.restart(propagation.held, sample);
+                self.levels.restart(sample);
             }
         }
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
