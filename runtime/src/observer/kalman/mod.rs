@@ -130,6 +130,15 @@
 //!    uncertain again by as much as the sample's gap says
 //!    ([`KalmanReport::released`]). Then, if the sample is still past the
 //!    gate, `P` is inflated by `yᵀS⁻¹y / N`. The sample is used.
+//!
+//!    **Weigh** each held contact against the run of samples before the
+//!    gate: a contact that no force holds can open more slowly than any
+//!    one sample shows (balls an inelastic collapse left touching, which
+//!    the plant's drift apart at 1e-4 m/s), and none is then past the
+//!    gate. A one-sided cumulative sum of the samples' standardised gaps
+//!    above the contact's level (module `opening`) makes the case, and a
+//!    contact it shows open is released as above, by the gap the run
+//!    shows over the time the contact has been held.
 //! 3. **Update** with `H = [I 0]`: `K = P Hᵀ S⁻¹`, `x ← x + K y` and the
 //!    Joseph form `P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ`, symmetrised.
 //!    Where the filter keeps a plant's likely steps apart
@@ -158,6 +167,7 @@ mod blocks;
 mod grid;
 mod level;
 mod mixture;
+mod opening;
 mod propagate;
 mod saltation;
 mod tune;
@@ -181,6 +191,7 @@ use crate::error::DataError;
 use crate::validate;
 use level::Levels;
 use mixture::Mixture;
+use opening::Openings;
 use propagate::Propagation;
 
 type Result<X, T> = core::result::Result<X, ObserverError<T>>;
@@ -807,6 +818,9 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     held_since: SVector<T, K>,
     /// The gaps the held contacts are held at (module `level`).
     levels: Levels<T, K>,
+    /// The case the samples build against each held contact (module
+    /// `opening`).
+    openings: Openings<T, K>,
     /// `P` plus the spread of the mixture's means: the covariance of the
     /// estimate the filter reports.
     reported: Blocks<T, N>,
@@ -888,6 +902,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             mixture: Mixture::empty(),
             held_since: SVector::repeat(t0),
             levels: Levels::surface(),
+            openings: Openings::none(t0),
             reported: p0,
         })
     }
@@ -1160,6 +1175,23 @@ where
         // R plus the floor above, so that exact samples (R = 0) never
         // leave S singular
         let floor = floor(&p);
+        // WEIGH the held contacts against the samples that show them
+        // open by a little each (module `opening`): one whose case is
+        // made is released before the sample is used, as the gate's
+        // release does
+        if let Some((h, jac)) = at_sample.as_ref() {
+            let (opened, gaps, spans) = self.openings.weigh(
+                (t, propagation.held, &self.levels.mean),
+                (h, jac),
+                (&self.params.measurement, floor, deviations),
+            );
+            if !opened.is_empty() {
+                release_contacts(model, q, (opened, &gaps, &spans), &mut p)?;
+                kalman.released += opened.len() as u32;
+            }
+        } else {
+            self.openings = Openings::none(t);
+        }
         let mut outliers = self.outliers;
         let gate = self.params.gate;
         let measurement = &self.params.measurement;
@@ -1185,7 +1217,7 @@ where
                 &self.params,
                 &mut p,
             )?;
-            kalman.released = released.len() as u32;
+            kalman.released += released.len() as u32;
             let mut nis = nis;
             if !released.is_empty() {
                 factored = factor(&p);
@@ -1326,15 +1358,12 @@ where
 /// across it) whose measured gap exceeds `n_σ` times the noise of the
 /// measurement along its normal, `√(J_i R J_iᵀ)`, plus the contact band
 /// `band` (`|J_i|` times it). The contact then gets back what the
-/// projection took, as a track started again along its normal: a normal
-/// position anywhere up to the measured gap `h_i` and, independent of it,
-/// a normal speed of the size that opens that gap in the time `span` since
-/// the samples last agreed, `P_qq += h_i² u uᵀ`, `P_vv += (h_i/span)² u
-/// uᵀ`, with `u = M⁻¹J_iᵀ/(J_i M⁻¹J_iᵀ)` (unit normal speed in the metric
-/// of `M`, as an impulse along the normal would give). The next samples
-/// then measure the speed. (Tying the two together, a separation at the
-/// start of `span`, made the billiard's estimate overshoot and stay 0.1
-/// m/s off for 20 ms.) Returns the constraints released.
+/// projection took, as a track started again along its normal
+/// ([`release_contacts`]), with the measured gap `h_i` and the time `span`
+/// since the samples last agreed. The next samples then measure the
+/// speed. (Tying the two together, a separation at the start of `span`,
+/// made the billiard's estimate overshoot and stay 0.1 m/s off for 20
+/// ms.) Returns the constraints released.
 fn release_open_contacts<M, T, const N: usize, const K: usize>(
     model: &M,
     (q, held): (&SVector<T, N>, IndexSet<K>),
@@ -1346,35 +1375,71 @@ where
     T: RealField + Copy,
     M: Sensitivities<N, K, Scalar = T>,
 {
-    let mut released = IndexSet::EMPTY;
+    let mut open = IndexSet::EMPTY;
     if held.is_empty() || span <= T::zero() {
-        return Ok(released);
+        return Ok(open);
     }
     let (h, jac) = model.contact(q);
     validate::finite_model(&h, "h")?;
     validate::finite_model(&jac, "J")?;
-    let mass = model.mass(q);
-    validate::finite_model(&mass, "M")?;
-    let chol = validate::factor_mass(&mass)?;
     for i in held {
         let row = jac.row(i);
         let sigma = (row * params.measurement * row.transpose())[0]
             .max(T::zero())
             .sqrt();
-        if h[i] <= params.observer.noise_sigmas * sigma + row.norm() * band {
+        if h[i] > params.observer.noise_sigmas * sigma + row.norm() * band {
+            open.insert(i);
+        }
+    }
+    release_contacts(model, q, (open, &h, &SVector::repeat(span)), p)
+}
+
+/// Releases the contacts `open` at the sample `q`, each with the gap
+/// `gaps[i]` the samples show it open by in the time `spans[i]` (the
+/// gate's release, [`release_open_contacts`], and the samples' case
+/// against a held contact, module `opening`): a normal
+/// position anywhere up to that gap and, independent of it, a normal speed
+/// of the size that opens it in that time, `P_qq += g_i² u uᵀ`, `P_vv +=
+/// (g_i/span_i)² u uᵀ`, with `u = M⁻¹J_iᵀ/(J_i M⁻¹J_iᵀ)` (unit normal speed
+/// in the metric of `M`, as an impulse along the normal would give).
+/// Returns the constraints released (a non-positive gap, span or
+/// Delassus entry releases nothing).
+fn release_contacts<M, T, const N: usize, const K: usize>(
+    model: &M,
+    q: &SVector<T, N>,
+    (open, gaps, spans): (IndexSet<K>, &SVector<T, K>, &SVector<T, K>),
+    p: &mut Blocks<T, N>,
+) -> Result<IndexSet<K>, T>
+where
+    T: RealField + Copy,
+    M: Sensitivities<N, K, Scalar = T>,
+{
+    let mut released = IndexSet::EMPTY;
+    if open.is_empty() {
+        return Ok(released);
+    }
+    let jac = model.gap_jacobian(q);
+    validate::finite_model(&jac, "J")?;
+    let mass = model.mass(q);
+    validate::finite_model(&mass, "M")?;
+    let chol = validate::factor_mass(&mass)?;
+    for i in open {
+        let (gap, span) = (gaps[i], spans[i]);
+        if !(gap > T::zero() && span > T::zero()) {
             continue;
         }
+        let row = jac.row(i);
         let minv_jt = chol.solve(&row.transpose());
         let delassus = row.dot(&minv_jt.transpose());
         if delassus <= T::zero() {
             continue;
         }
         let u = minv_jt / delassus;
-        let speed = h[i] / span;
+        let speed = gap / span;
         let along = u * u.transpose();
         *p = p
             .add(&Blocks::diagonal(
-                along * (h[i] * h[i]),
+                along * (gap * gap),
                 along * (speed * speed),
             ))
             .symmetrized();
@@ -1478,6 +1543,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         (self.mixture, self.reported) = (Mixture::empty(), p);
         self.held_since = SVector::repeat(t);
         self.levels = Levels::surface();
+        self.openings = Openings::none(t);
         (self.sample, self.fresh) = (q, true);
         (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
         Self::estimate(self)
