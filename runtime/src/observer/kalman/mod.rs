@@ -902,7 +902,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             mixture: Mixture::empty(),
             held_since: SVector::repeat(t0),
             levels: Levels::surface(),
-            openings: Openings::none(t0),
+            openings: Openings::none(),
             reported: p0,
         })
     }
@@ -1189,8 +1189,8 @@ where
                 release_contacts(model, q, (opened, &gaps, &spans), &mut p)?;
                 kalman.released += opened.len() as u32;
             }
-        } else {
-            self.openings = Openings::none(t);
+        } else if !self.openings.is_none() {
+            self.openings = Openings::none();
         }
         let mut outliers = self.outliers;
         let gate = self.params.gate;
@@ -1543,7 +1543,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
         (self.mixture, self.reported) = (Mixture::empty(), p);
         self.held_since = SVector::repeat(t);
         self.levels = Levels::surface();
-        self.openings = Openings::none(t);
+        self.openings = Openings::none();
         (self.sample, self.fresh) = (q, true);
         (self.outliers, self.report, self.kalman) = (0, report, KalmanReport::empty());
         Self::estimate(self)
