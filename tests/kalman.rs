@@ -2765,7 +2765,7 @@ moreau::model! {
 /// or refusal, at most 1 % of the samples skipped, and at most 2e-2 m/s
 /// off the samples that bracket a plant impact. Measured: at most 28
 /// skipped (start 9), at most 1.2e-2 off (start 6, unchanged by the
-/// weighing); start 11 now 1 skipped, 1.0e-2 off, NEES median 2.6. The
+/// weighing); start 11 now 1 skipped, 1.07e-2 off, NEES median 2.6. The
 /// NEES of starts 2 to 5 and 8 to 10 stays between 1.9e2 and 6.1e3: what
 /// their collapses leave is a velocity error of 1e-5 to 1e-3 m/s on balls
 /// that fly free (the collapse's many small impacts contract the
