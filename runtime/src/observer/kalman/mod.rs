@@ -674,8 +674,9 @@ pub struct KalmanReport<T> {
     pub saltations: u32,
     /// Projections of the covariance onto a contact manifold.
     pub projections: u32,
-    /// Persistent contacts released because the samples showed them open
-    /// after the model had failed (module docs, step 2).
+    /// Persistent contacts released because the samples showed them open:
+    /// one sample after the model had failed, or the run of samples since
+    /// the contact was held (module docs, step 2).
     pub released: u32,
     /// Predictions made again at a new linearisation point (only the
     /// first update after a start or a restart: module docs, step 1, "Relinearised").

@@ -10,7 +10,8 @@
 //! slowly, and the plant may be leaving. Three balls on a line with
 //! restitution 0.3 end an inelastic collapse against a wall with the
 //! plant's balls drifting apart at 1e-4 to 4e-4 m/s, and the filter's
-//! glued (the scratch sweep of this stop, `ThreeBallsE3`, start 11). No
+//! glued (start 11 of `tests/kalman.rs`,
+//! `balls_left_touching_by_a_collapse_part_as_the_samples_show`). No
 //! sample could move the estimate off the contacts, and none is past the
 //! gate: 2.5 s later the wall contact, held, was 2.6 deviations open in
 //! every sample, the balls beside it were 0.07 m/s off, and the velocity
@@ -33,8 +34,8 @@
 //! speed since the run began reaches now; a single sample's gap is as
 //! noisy as the measurement) and by that gap over the time the contact
 //! has been held (a run is as short as the noise that ends it early
-//! makes it: a speed over the run was 25 times the plant's in the unit
-//! test below) ([`KalmanReport::released`](super::KalmanReport::released)).
+//! makes it: the gap over the run alone gave 25 times the plant's speed
+//! in the unit test below) ([`KalmanReport::released`](super::KalmanReport::released)).
 //! The sum starts again from zero, and so does that of a contact not held.
 
 use nalgebra::{RealField, SMatrix, SVector};
@@ -173,8 +174,8 @@ mod tests {
             let opened = at_rest.weigh((k as f64 * 1e-3, held, &level), (&h, &jac), (&r, 0.0, 4.7));
             assert!(opened.0.is_empty(), "sample {k}");
         }
-        // 2e-4 m/s from t = 0: the mean gap reaches κ σ at 0.25 s, and
-        // the sum passes H by about 0.13 s later
+        // 2e-4 m/s from t = 0: the gap reaches κ σ at 0.25 s, about
+        // where the sum passes H with the noise's help (measured: 0.251 s)
         let mut opening = Openings::<f64, 1>::none();
         let speed = 2e-4;
         let found = (1..1000).find_map(|k| {
