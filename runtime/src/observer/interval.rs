@@ -106,6 +106,13 @@ pub(crate) fn injection_gain<T: RealField + Copy>(l_d: T, tau: T) -> T {
     -(-(l_d * tau)).exp_m1() / tau
 }
 
+/// The rounding of a normal speed `J_i w` read at the velocity `w`, per
+/// unit of `|J_i|`: `64 ε |w|`. The contact rule's speed tests leave it
+/// out of every class (approaching, separating, resting) they compare.
+pub(crate) fn speed_roundoff<T: RealField + Copy, const N: usize>(w: &SVector<T, N>) -> T {
+    T::default_epsilon() * nalgebra::convert(64.0) * w.norm()
+}
+
 /// `h > |r| b` shown without the square root of `|r|`: `true` only when it
 /// holds with a margin of two (`h² > 4 |r|² b²`), far beyond rounding, so
 /// that `false` leaves the exact test `h ≤ |r| b` to the caller. Sound for
@@ -1211,7 +1218,7 @@ where
         let (p, w, accel) = (at.p, at.w, &at.free.accel);
         let mut c = Classes::default();
         let noise_speed = self.noise_speed;
-        let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
+        let roundoff = speed_roundoff(w);
         let four: T = nalgebra::convert(4.0);
         let mut closed = IndexSet::<K>::EMPTY;
         let kept = touched.union(held);

@@ -14,7 +14,7 @@ use crate::model::Model;
 
 use super::{
     Contact, Crossing, Free, Interval, Law, Path, Point, Result, Segment, UpdateReport,
-    check_contact,
+    check_contact, speed_roundoff,
 };
 
 /// One piece of predicted flight: from `(p0, w0)` at local time `s0`, of
@@ -171,7 +171,7 @@ where
         let (mut w_plus, mut law) = self.newton(at, (set, elastic), together, report)?;
         // each round adds a constraint to the set: at most K rounds
         loop {
-            let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w_plus.norm();
+            let roundoff = speed_roundoff(&w_plus);
             let mut joined = IndexSet::EMPTY;
             for j in resolved.difference(set) {
                 let row = at.jac.row(j);
@@ -307,7 +307,7 @@ where
                 // before its wall, met with the floor took the arm's swing
                 // back through Newton's law on two nearly opposite
                 // gradients)
-                let roundoff = T::default_epsilon() * nalgebra::convert(64.0) * w.norm();
+                let roundoff = speed_roundoff(&w);
                 let resting = path.held.intersection(c.contact).iter().any(|i| {
                     let row = jac.row(i);
                     row.dot(&w.transpose()) <= roundoff * row.norm()

@@ -1187,7 +1187,7 @@ where
                 (&self.params.measurement, floor, deviations),
             );
             if !opened.is_empty() {
-                release_contacts(model, q, (opened, &gaps, &spans), &mut p)?;
+                release_contacts(model, (q, jac), (opened, &gaps, &spans), &mut p)?;
                 kalman.released += opened.len() as u32;
             }
         } else if !self.openings.is_none() {
@@ -1392,7 +1392,7 @@ where
             open.insert(i);
         }
     }
-    release_contacts(model, q, (open, &h, &SVector::repeat(span)), p)
+    release_contacts(model, (q, &jac), (open, &h, &SVector::repeat(span)), p)
 }
 
 /// Releases the contacts `open` at the sample `q`, each with the gap
@@ -1403,11 +1403,12 @@ where
 /// of the size that opens it in that time, `P_qq += g_i² u uᵀ`, `P_vv +=
 /// (g_i/span_i)² u uᵀ`, with `u = M⁻¹J_iᵀ/(J_i M⁻¹J_iᵀ)` (unit normal speed
 /// in the metric of `M`, as an impulse along the normal would give).
+/// `jac` is `J(q)`, which both callers have evaluated at the sample.
 /// Returns the constraints released (a non-positive gap, span or
 /// Delassus entry releases nothing).
 fn release_contacts<M, T, const N: usize, const K: usize>(
     model: &M,
-    q: &SVector<T, N>,
+    (q, jac): (&SVector<T, N>, &SMatrix<T, K, N>),
     (open, gaps, spans): (IndexSet<K>, &SVector<T, K>, &SVector<T, K>),
     p: &mut Blocks<T, N>,
 ) -> Result<IndexSet<K>, T>
@@ -1419,8 +1420,6 @@ where
     if open.is_empty() {
         return Ok(released);
     }
-    let jac = model.gap_jacobian(q);
-    validate::finite_model(&jac, "J")?;
     let mass = model.mass(q);
     validate::finite_model(&mass, "M")?;
     let chol = validate::factor_mass(&mass)?;
