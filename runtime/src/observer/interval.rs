@@ -603,7 +603,9 @@ where
     /// How well the estimate knows the velocity: the correction the last
     /// update's innovation made, `|d_k| (1 − e^{−l_d τ_k}) / τ_k` (0 before
     /// the first update). A closed constraint approaching slower than that
-    /// cannot be told from a resting one.
+    /// cannot be told from a resting one. The filter sets it to its own
+    /// velocity noise `n_σ σ_v` with exact samples and to zero under
+    /// noise, where that noise is already the resting speed's `ν`.
     pub uncertainty: T,
     /// The contact rule's band `b_i` of each constraint, in units of `q`:
     /// [`ObserverParams::contact_band`] for every constraint (set by

@@ -28,7 +28,10 @@
 //!    [`KalmanParams::band_sigmas`] (default 1) times the deviation of
 //!    the estimate's own gap along its normal, `σ_i = √(J_i P_qq J_iᵀ) /
 //!    |J_i|` (at least the rounding of `q`, at most `σ`), the velocity
-//!    tests `n_σ` times `σ_v = √max P_vv,ii`. The prediction starts from
+//!    tests `n_σ` times `σ_v = √max P_vv,ii`, counted once: as the
+//!    velocity noise `ν` of the resting speed (with exact samples, where
+//!    `ν` is zero, as the uncertainty an approach must exceed to bounce).
+//!    The prediction starts from
 //!    the filtered `q̂_k`, not from a raw sample, so a bounce a few `σ_i`
 //!    high (`σ_i` a small fraction of `σ` after a few samples) is told
 //!    from sliding. The interval tells each piece of
@@ -1033,13 +1036,20 @@ where
         let plan = self
             .screen
             .screen(&self.params.observer, (t, interval.tau), &self.q, q)?;
-        // (with exact samples, `σ = 0`, no noise term, as for the observers)
-        interval.noise_speed = if measured_sigma > T::zero() {
-            rule.noise_sigmas * sigma_v
+        // the estimate's velocity noise `n_σ σ_v` enters the rule once: as
+        // its velocity noise `ν` (in the resting speed), or with exact
+        // samples, `σ = 0`, where `ν` is zero as for the observers, as the
+        // uncertainty a bounce must exceed. Counted in both, a bounce had
+        // to approach `n_σ σ_v` faster than the resting speed, and
+        // approaches the filter could tell from rest were closed
+        // plastically (`tests/kalman.rs`,
+        // `an_approach_the_filter_can_tell_from_rest_bounces`)
+        let velocity_noise = rule.noise_sigmas * sigma_v;
+        (interval.noise_speed, interval.uncertainty) = if measured_sigma > T::zero() {
+            (velocity_noise, T::zero())
         } else {
-            T::zero()
+            (T::zero(), velocity_noise)
         };
-        interval.uncertainty = rule.noise_sigmas * sigma_v;
         // each constraint's band from the deviation of its own gap,
         // `√(J_i P_qq J_iᵀ) / |J_i|`, at least the rounding of `q` and at
         // most `σ` (where the model fails at the estimate the whole
