@@ -2604,6 +2604,35 @@ where
     (counted, skipped)
 }
 
+/// Example 1's floor `y = x²` at `x0`: its unit tangent and its unit
+/// normal into the domain.
+fn floor_frame(x0: f64) -> (Vector2<f64>, Vector2<f64>) {
+    (
+        Vector2::new(1.0, 2.0 * x0).normalize(),
+        Vector2::new(-2.0 * x0, 1.0).normalize(),
+    )
+}
+
+/// A filter with the defaults at `σ` = 1e-4 started from `(q0, v0)` near
+/// Example 1's floor at `x0`, knowing its position to `s_t` along the
+/// floor and `s_n` across it (as a run of micro-bounces leaves it) and its
+/// velocity to `s_v` in each coordinate.
+fn filter_over_the_floor(
+    x0: f64,
+    (q0, v0): (Vector2<f64>, Vector2<f64>),
+    (s_t, s_n, s_v): (f64, f64, f64),
+) -> SaltationKalman<f64, 2, 2> {
+    let (tangent, normal) = floor_frame(x0);
+    let p0 = Blocks {
+        qq: tangent * tangent.transpose() * (s_t * s_t) + normal * normal.transpose() * (s_n * s_n),
+        qv: SMatrix::zeros(),
+        vq: SMatrix::zeros(),
+        vv: SMatrix::identity() * (s_v * s_v),
+    };
+    let params = KalmanParams::new(20.0, 1e-4);
+    SaltationKalman::<f64, 2, 2>::with_covariance(params, 0.0, q0, v0, p0).expect("filter")
+}
+
 /// A bounce the filter can tell from sliding is followed, not held. The
 /// mass has just left Example 1's floor at `x = −1` with 0.95 m/s along it
 /// and `s` = 1e-2 m/s across it, and the filter knows its position 5.2e-6
@@ -2629,19 +2658,9 @@ fn a_bounce_faster_than_its_gaps_band_is_followed_not_held() {
     let g = 9.81;
     let (x0, tau) = (-1.0_f64, 1e-3);
     let q0 = Vector2::new(x0, x0 * x0);
-    let tangent = Vector2::new(1.0, 2.0 * x0).normalize();
-    let normal = Vector2::new(-2.0 * x0, 1.0).normalize();
+    let (tangent, normal) = floor_frame(x0);
     let v0 = tangent * 0.95 + normal * 1e-2;
-    let (s_t, s_n, s_v) = (5.2e-6, 1.2e-6, 3.3e-4);
-    let p0 = Blocks {
-        qq: tangent * tangent.transpose() * (s_t * s_t) + normal * normal.transpose() * (s_n * s_n),
-        qv: SMatrix::zeros(),
-        vq: SMatrix::zeros(),
-        vv: SMatrix::identity() * (s_v * s_v),
-    };
-    let params = KalmanParams::new(20.0, 1e-4);
-    let mut filter =
-        SaltationKalman::<f64, 2, 2>::with_covariance(params, 0.0, q0, v0, p0).expect("filter");
+    let mut filter = filter_over_the_floor(x0, (q0, v0), (5.2e-6, 1.2e-6, 3.3e-4));
     // the exact flight: no force but gravity, and the floor not reached
     let q1 = q0 + v0 * tau + Vector2::new(0.0, -0.5 * g * tau * tau);
     let v1 = v0 + Vector2::new(0.0, -g * tau);
@@ -2688,20 +2707,10 @@ fn an_approach_the_filter_can_tell_from_rest_bounces() {
     let model = Parabola::<f64>::new();
     let (g, e) = (9.81, 0.9);
     let (x0, tau, s) = (-1.0_f64, 1e-3, 9e-3);
-    let tangent = Vector2::new(1.0, 2.0 * x0).normalize();
-    let normal = Vector2::new(-2.0 * x0, 1.0).normalize();
+    let (tangent, normal) = floor_frame(x0);
     let q0 = Vector2::new(x0, x0 * x0) + normal * 2e-6;
     let v0 = tangent * 0.3 - normal * s;
-    let (s_t, s_n, s_v) = (5e-6, 1e-6, 1e-3);
-    let p0 = Blocks {
-        qq: tangent * tangent.transpose() * (s_t * s_t) + normal * normal.transpose() * (s_n * s_n),
-        qv: SMatrix::zeros(),
-        vq: SMatrix::zeros(),
-        vv: SMatrix::identity() * (s_v * s_v),
-    };
-    let params = KalmanParams::new(20.0, 1e-4);
-    let mut filter =
-        SaltationKalman::<f64, 2, 2>::with_covariance(params, 0.0, q0, v0, p0).expect("filter");
+    let mut filter = filter_over_the_floor(x0, (q0, v0), (5e-6, 1e-6, 1e-3));
     // the exact motion: flight, the floor's root, Newton's law, flight
     let accel = Vector2::new(0.0, -g);
     let fly = |q: Vector2<f64>, v: Vector2<f64>, t: f64| {
