@@ -1847,6 +1847,56 @@ fn example_1_random_starts_beside_the_reduced_order_observer() {
     assert!(met_step >= met_gauss);
 }
 
+/// The issue's maximum on 96 more random starts of Example 1, drawn with
+/// eight seeds that no other test uses and that no change was measured
+/// on before this test (7, 99, 123, 2718, 31, 4242, 8080 and 1001; twelve
+/// starts each, `random_example_1_starts`), run as
+/// `example_1_random_starts_beside_the_reduced_order_observer` runs its
+/// 48: plant at `τ = 1e-5`, 1 kHz, `σ = 1e-4`, `v̂(0) = 0`, scored over
+/// `[2, 10]` s, with the defaults and told the plant's step.
+///
+/// Asserted: the maximum off the samples that bracket a plant impact is
+/// within the issue's 1e-2 on every start, both ways. Measured: at most
+/// 6.7e-3 with the defaults and 8.8e-3 told the plant; the median and the
+/// 90th percentile together meet the issue's on 31 and 82 of the 96.
+/// Before the filter counted its velocity noise once in the contact rule
+/// (`an_approach_the_filter_can_tell_from_rest_bounces`), seed 7, start 4
+/// was 1.18e-2 off told the plant, at micro-bounces the rule closed
+/// plastically, and fourteen starts' maxima were higher (none lower).
+#[test]
+fn example_1_maximum_holds_on_96_more_random_starts() {
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let sigma = 1e-4;
+    let issue = |f: &Scored| f.all.median <= 3e-5 && f.all.p90 <= 2e-4;
+    let (mut met, mut met_step, mut runs) = (0, 0, 0);
+    let (mut worst, mut worst_step) = (0.0_f64, 0.0_f64);
+    for seed in [7, 99, 123, 2718, 31, 4242, 8080, 1001] {
+        for (n, start) in random_example_1_starts(seed, 12).into_iter().enumerate() {
+            let data = reference(&model, start, 1e-5, 100, 10.0, &u);
+            let measured = measure(&data, sigma, 100 + n as u64);
+            let sc = with_defaults(&data, &measured, sigma);
+            let told = KalmanParams::new(20.0, sigma).with_plant_step(1e-5);
+            let sp = with_params(&data, &measured, told);
+            runs += 1;
+            met += usize::from(issue(&sc));
+            met_step += usize::from(issue(&sp));
+            worst = worst.max(sc.clean.max);
+            worst_step = worst_step.max(sp.clean.max);
+            let at = format!("seed {seed}, start {n}");
+            assert!(sc.clean.max <= 1e-2, "{at}: {:e}", sc.clean.max);
+            assert!(
+                sp.clean.max <= 1e-2,
+                "{at}, the plant's step: {:e}",
+                sp.clean.max
+            );
+        }
+    }
+    eprintln!(
+        "{runs} more starts: maximum off the brackets at most {worst:.2e} with the defaults, {worst_step:.2e} told the plant's step; the issue's median and 90th percentile met on {met} and {met_step}"
+    );
+}
+
 /// Where the filter keeps an impact's likely steps apart (a sum of
 /// Gaussians, module `mixture`), the covariance it reports (`P` plus the
 /// spread of the means) is not overconfident. The reference is a fact
