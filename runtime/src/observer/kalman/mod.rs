@@ -1197,8 +1197,8 @@ where
                 (&self.params.measurement, floor, deviations),
             );
             if !opened.is_empty() {
-                release_contacts(model, (q, jac), (opened, &gaps, &spans), &mut p)?;
-                kalman.released += opened.len() as u32;
+                let released = release_contacts(model, (q, jac), (opened, &gaps, &spans), &mut p)?;
+                kalman.released += released.len() as u32;
             }
         } else if !self.openings.is_none() {
             self.openings = Openings::none();
