@@ -2063,6 +2063,105 @@ fn the_filter_beside_the_gaussian_posterior() {
     assert!(out_of_reach >= 1 && met_beyond >= 1);
 }
 
+/// Whether the filter's misses of the median and 90th percentile
+/// are the method's or the draw's. A miss on one noise draw says little:
+/// a run's 90th percentile is set by a few stretches of correlated error
+/// after fast impacts, and moves by a factor of two or more from one
+/// draw of the noise to another. So each of the 52 Example 1 runs of
+/// [`the_filter_beside_the_gaussian_posterior`] (the same starts) is run
+/// on 20 fresh noise draws (noise seeds 60 000 to 60 019, which no other
+/// test uses), told the plant (`with_plant_step(1e-5)`), σ = 1e-4, 1 kHz,
+/// `[2, 10]` s, and its coverage, the fraction of samples within `r` of
+/// the truth, is set beside the coverage the Gaussian posterior of the
+/// plant's own noise allows any estimator in expectation
+/// ([`common::posterior::coverage`], Anderson's lemma: module docs of
+/// `tests/common/posterior.rs`), at the two radii: `r` = 3e-5 (a
+/// median within 3e-5 is a coverage of at least one half) and 2e-4 (a
+/// 90th percentile within 2e-4, at least nine tenths).
+///
+/// Asserted, at both radii: on each start, the filter's mean coverage over
+/// the 20 draws is within 0.05 (a twentieth of the samples) of the
+/// posterior's or above it; in the mean over the 52 starts, within 0.01
+/// or above (the posterior is first order and leaves out the acceleration
+/// and contact noise the filter runs with, so it is a yardstick, not a
+/// bound); and on every start the filter meets both of the numbers
+/// on at least one draw, so that no start is out of its reach. Measured:
+/// the filter minus the posterior −0.015 to +0.019 at 2e-4 and −0.025 to
+/// +0.107 at 3e-5 (means over the starts +0.005 and +0.021); both numbers
+/// met on 6 to 20 draws of 20 per start, 910 of the 1040 runs (832 of
+/// the 960 on the 48 random starts). The starts met on fewest draws are
+/// those whose posterior coverage is nearest the target (0.89 to 0.90 at
+/// 2e-4: 6 to 13 of 20; 0.43 to 0.47 at 3e-5: 10 to 16 of 20), where any
+/// estimator's figures land on either side of the from one draw
+/// to the next. The same starts on 20 other draws (noise seeds 5000 to
+/// 5019, a scratch run) met both on 827 of the 960, each start on 5 to
+/// 20: which draws of a start miss changes with the draws. The filter
+/// with its defaults (not told the plant) fails the first assertion on
+/// the first start: 0.74 of its samples within 3e-5, where the posterior
+/// allows 0.83.
+///
+/// `cargo test --release --test kalman -- --nocapture over_noise_draws`
+/// (20 s)
+#[test]
+fn the_filter_covers_what_the_posterior_allows_over_noise_draws() {
+    use common::posterior::{coverage, velocity_covariances};
+    const DRAWS: u64 = 20;
+    let radii = [3e-5, 2e-4];
+    let model = Parabola::<f64>::new();
+    let u = SVector::zeros();
+    let sigma = 1e-4;
+    let told = KalmanParams::new(20.0, sigma).with_plant_step(1e-5);
+    let (mut gaps, mut met_runs, mut runs) = ([0.0; 2], 0, 0);
+    let starts = common::runs::example_1_runs();
+    for (at, start, _) in &starts {
+        let data = reference(&model, *start, 1e-5, 100, 10.0, &u);
+        let covariances = velocity_covariances(&data, sigma, 1e-5, WINDOW);
+        let allowed = radii.map(|r| coverage(&covariances, r));
+        let (mut covered, mut met) = ([0.0; 2], 0);
+        for draw in 0..DRAWS {
+            let measured = measure(&data, sigma, 60_000 + draw);
+            let mut f = SaltationKalman::<f64, 2, 2>::new(told, 0.0, measured[0], Vector2::zeros())
+                .unwrap();
+            let estimates = run(&mut f, &model, &data, &measured, &u);
+            let in_window: Vec<f64> = common::runs::errors(&data, &estimates)
+                .into_iter()
+                .zip(&data.samples)
+                .filter(|(_, s)| s.t >= WINDOW.0 - 1e-9 && s.t < WINDOW.1 - 1e-9)
+                .map(|(e, _)| e)
+                .collect();
+            for (c, r) in covered.iter_mut().zip(radii) {
+                let within = in_window.iter().filter(|&&e| e <= r).count();
+                *c += within as f64 / in_window.len() as f64 / DRAWS as f64;
+            }
+            let f = figures(&in_window);
+            met += usize::from(f.median <= 3e-5 && f.p90 <= 2e-4);
+        }
+        eprintln!(
+            "{at}: both numbers met on {met} of {DRAWS} draws; coverage within 3e-5: posterior {:.3}, filter {:.3}; within 2e-4: posterior {:.3}, filter {:.3}",
+            allowed[0], covered[0], allowed[1], covered[1]
+        );
+        for k in 0..2 {
+            assert!(
+                covered[k] >= allowed[k] - 0.05,
+                "{at}, r = {:e}: filter {} against the posterior's {}",
+                radii[k],
+                covered[k],
+                allowed[k]
+            );
+            gaps[k] += (covered[k] - allowed[k]) / starts.len() as f64;
+        }
+        assert!(met >= 1, "{at}: the issue's numbers met on no draw");
+        (met_runs, runs) = (met_runs + met, runs + DRAWS as usize);
+    }
+    eprintln!(
+        "the filter's coverage minus the posterior's, mean over the {} starts: {:+.3} within 3e-5, {:+.3} within 2e-4; both numbers met on {met_runs} of {runs} runs",
+        starts.len(),
+        gaps[0],
+        gaps[1]
+    );
+    assert!(gaps.iter().all(|&g| g >= -0.01), "{gaps:?}");
+}
+
 moreau::model! {
     /// A ball inside a round bowl (a circle of radius 1 in a vertical
     /// plane): it bounces off the inside of the rim, and slides along it

@@ -97,6 +97,13 @@ fn within_spread((l1, l2): (f64, f64), r: f64) -> f64 {
     sum / POINTS as f64
 }
 
+/// The fraction of samples an estimator can expect within `r` over a
+/// run whose posterior covariances are `covariances`: the mean of
+/// [`within`] (module docs).
+pub fn coverage(covariances: &[Matrix2<f64>], r: f64) -> f64 {
+    covariances.iter().map(|p| within(p, r)).sum::<f64>() / covariances.len() as f64
+}
+
 /// The radius `r` at which the fraction of samples an estimator can
 /// expect within `r`, the mean of [`within`] over `covariances`, is
 /// `fraction` (module docs), by bisection in `log r` over 1e-9 to 1 m/s.
