@@ -2085,7 +2085,17 @@ fn the_filter_beside_the_gaussian_posterior() {
 /// or above (the posterior is first order and leaves out the acceleration
 /// and contact noise the filter runs with, so it is a yardstick, not a
 /// bound); and on every start the filter meets both of the issue's numbers
-/// on at least one draw, so that no start is out of its reach. Measured:
+/// on at least one draw, so that no start is out of its reach. On the
+/// same draws, the filter's maximum off the samples that bracket a plant
+/// impact is within the issue's 1e-2 on every run, told the plant and
+/// with its defaults (asserted; measured at most 6.05e-3 and 5.77e-3),
+/// and the defaults meet both numbers on 403 of the 1040 runs (printed).
+/// (38), told `σ`, is printed beside it: its maximum off the brackets is
+/// above the issue's 0.1 on 31 of the 1040 (at most 0.199), seven of them
+/// on the four starts of the issue's table (three on the file's start, one
+/// on (−1, 3), three on (0.2, 1)); the worst draw of the file's start
+/// (0.171) was traced to its accumulation on the curved floor (design
+/// record, "(38) under noise over noise draws"). Measured:
 /// the filter minus the posterior −0.015 to +0.019 at 2e-4 and −0.025 to
 /// +0.107 at 3e-5 (means over the starts +0.005 and +0.021); both numbers
 /// met on 6 to 20 draws of 20 per start, 910 of the 1040 runs (832 of
@@ -2101,7 +2111,7 @@ fn the_filter_beside_the_gaussian_posterior() {
 /// allows 0.83.
 ///
 /// `cargo test --release --test kalman -- --nocapture over_noise_draws`
-/// (20 s)
+/// (30 s)
 #[test]
 fn the_filter_covers_what_the_posterior_allows_over_noise_draws() {
     use common::posterior::{coverage, velocity_covariances};
@@ -2111,7 +2121,9 @@ fn the_filter_covers_what_the_posterior_allows_over_noise_draws() {
     let u = SVector::zeros();
     let sigma = 1e-4;
     let told = KalmanParams::new(20.0, sigma).with_plant_step(1e-5);
-    let (mut gaps, mut met_runs, mut runs) = ([0.0; 2], 0, 0);
+    let issue = |f: &Scored| f.all.median <= 3e-5 && f.all.p90 <= 2e-4;
+    let (mut gaps, mut met_runs, mut met_defaults, mut runs) = ([0.0; 2], 0, 0, 0);
+    let (mut worst, mut worst_defaults, mut over_38, mut worst_38) = (0.0_f64, 0.0_f64, 0, 0.0_f64);
     let starts = common::runs::example_1_runs();
     for (at, start, _) in &starts {
         let data = reference(&model, *start, 1e-5, 100, 10.0, &u);
@@ -2133,8 +2145,22 @@ fn the_filter_covers_what_the_posterior_allows_over_noise_draws() {
                 let within = in_window.iter().filter(|&&e| e <= r).count();
                 *c += within as f64 / in_window.len() as f64 / DRAWS as f64;
             }
-            let f = figures(&in_window);
-            met += usize::from(f.median <= 3e-5 && f.p90 <= 2e-4);
+            let scored = score(&data, &estimates, WINDOW);
+            met += usize::from(issue(&scored));
+            // the same draw with the defaults and beside (38)
+            let defaults = with_defaults(&data, &measured, sigma);
+            let observer = reduced_order(&data, &measured, sigma);
+            let here = format!("{at}, draw {draw}");
+            assert_maximum_off_the_brackets((&defaults, &scored), &here);
+            met_defaults += usize::from(issue(&defaults));
+            (worst, worst_defaults) = (
+                worst.max(scored.clean.max),
+                worst_defaults.max(defaults.clean.max),
+            );
+            (over_38, worst_38) = (
+                over_38 + usize::from(observer.clean.max > 0.1),
+                worst_38.max(observer.clean.max),
+            );
         }
         eprintln!(
             "{at}: both numbers met on {met} of {DRAWS} draws; coverage within 3e-5: posterior {:.3}, filter {:.3}; within 2e-4: posterior {:.3}, filter {:.3}",
@@ -2154,7 +2180,7 @@ fn the_filter_covers_what_the_posterior_allows_over_noise_draws() {
         (met_runs, runs) = (met_runs + met, runs + DRAWS as usize);
     }
     eprintln!(
-        "the filter's coverage minus the posterior's, mean over the {} starts: {:+.3} within 3e-5, {:+.3} within 2e-4; both numbers met on {met_runs} of {runs} runs",
+        "the filter's coverage minus the posterior's, mean over the {} starts: {:+.3} within 3e-5, {:+.3} within 2e-4; both numbers met on {met_runs} of {runs} runs (with the defaults: {met_defaults}); maximum off the brackets at most {worst:.2e} ({worst_defaults:.2e} with the defaults); (38)'s above 0.1 on {over_38} of {runs}, at most {worst_38:.3}",
         starts.len(),
         gaps[0],
         gaps[1]
