@@ -198,6 +198,26 @@ pub fn brackets<const N: usize>(data: &Reference<N>) -> Vec<bool> {
     bracket
 }
 
+/// Whether the sample `s` lies in the scoring window `[from, to)`.
+fn in_window<const N: usize>(s: &State<f64, N>, (from, to): (f64, f64)) -> bool {
+    s.t >= from - 1e-9 && s.t < to - 1e-9
+}
+
+/// `|v − v̂|` at the samples in the window `[from, to)`, as [`score`]
+/// scores them.
+pub fn errors_in_window<const N: usize>(
+    data: &Reference<N>,
+    estimates: &[Estimate<f64, N>],
+    window: (f64, f64),
+) -> Vec<f64> {
+    data.samples
+        .iter()
+        .zip(errors(data, estimates))
+        .filter(|(s, _)| in_window(s, window))
+        .map(|(_, e)| e)
+        .collect()
+}
+
 pub fn score<const N: usize>(
     data: &Reference<N>,
     estimates: &[Estimate<f64, N>],
@@ -215,13 +235,12 @@ pub fn score<const N: usize>(
             recover.push(back);
         }
     }
-    let in_window = |s: &State<f64, N>| s.t >= from - 1e-9 && s.t < to - 1e-9;
     let pick = |skip_brackets: bool| -> Vec<f64> {
         data.samples
             .iter()
             .zip(&errors)
             .zip(&bracket)
-            .filter(|((s, _), b)| in_window(s) && !(skip_brackets && **b))
+            .filter(|((s, _), b)| in_window(s, (from, to)) && !(skip_brackets && **b))
             .map(|((_, &e), _)| e)
             .collect()
     };
