@@ -99,6 +99,7 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
     /// assert_eq!(phi.apply(&Vector1::new(1.0), &Vector1::new(2.0)), (Vector1::new(2.0), Vector1::new(2.0)));
     /// ```
     #[must_use]
+    #[inline]
     pub fn apply(&self, a: &SVector<T, N>, b: &SVector<T, N>) -> (SVector<T, N>, SVector<T, N>) {
         (self.qq * a + self.qv * b, self.vq * a + self.vv * b)
     }
@@ -116,6 +117,7 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
 
     /// The sum `self + other`.
     #[must_use]
+    #[inline]
     pub fn add(&self, o: &Self) -> Self {
         Self {
             qq: self.qq + o.qq,
@@ -134,6 +136,7 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
     /// assert_eq!((b.entry(0, 0), b.entry(3, 3), b.entry(0, 2)), (3.0, 3.0, 0.0));
     /// ```
     #[must_use]
+    #[inline]
     pub fn scaled(&self, c: T) -> Self {
         Self {
             qq: self.qq * c,
@@ -153,6 +156,7 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
     /// assert_eq!((b.entry(0, 0), b.entry(0, 1), b.entry(1, 0), b.entry(1, 1)), (4.0, 6.0, 6.0, 9.0));
     /// ```
     #[must_use]
+    #[inline]
     pub fn outer(a: &SVector<T, N>, b: &SVector<T, N>) -> Self {
         let ab = a * b.transpose();
         Self {
@@ -395,6 +399,7 @@ impl<T: RealField + Copy, const N: usize> Blocks<T, N> {
     }
 
     /// Whether every entry is finite.
+    #[inline]
     pub fn is_finite(&self) -> bool {
         [&self.qq, &self.qv, &self.vq, &self.vv]
             .iter()

@@ -1352,13 +1352,21 @@ where
             }
         }
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
-        self.reported = if mixture.is_empty() {
-            p
+        // the estimate and its covariance: the mixture's moments, where
+        // the filter keeps steps apart (each weight's `exp` once)
+        let ((dq, dv), reported) = if mixture.is_empty() {
+            (mixture::no_offset(), p)
         } else {
-            p.add(&mixture.spread())
+            let (mean, spread) = mixture.moments();
+            (mean, p.add(&spread))
         };
+        self.reported = reported;
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
-        Ok(Self::estimate(self))
+        Ok(Estimate {
+            t: self.t,
+            q: self.q + dq,
+            v: self.v + dv,
+        })
     }
 }
 

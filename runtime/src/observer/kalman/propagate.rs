@@ -615,8 +615,8 @@ where
     /// Merges the mixture into the prediction: the offset moves to its
     /// mean, and its spread joins the covariance.
     fn collapse(&mut self) {
-        let (dq, dv) = self.mixture.mean();
-        self.p = self.p.add(&self.mixture.spread()).symmetrized();
+        let ((dq, dv), spread) = self.mixture.moments();
+        self.p = self.p.add(&spread).symmetrized();
         self.offset.0 += dq;
         self.offset.1 += dv;
         self.mixture = Mixture::empty();
