@@ -932,7 +932,12 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
     /// ([`KalmanParams::plant_step_mixture`]).
     #[must_use]
     pub fn estimate(&self) -> Estimate<T, N> {
-        let (dq, dv) = self.mixture.mean();
+        self.estimate_at(self.mixture.mean())
+    }
+
+    /// The estimate with the mixture's mean `(dq, dv)` already computed
+    /// (the update has it from the mixture's moments).
+    fn estimate_at(&self, (dq, dv): mixture::Offset<T, N>) -> Estimate<T, N> {
         Estimate {
             t: self.t,
             q: self.q + dq,
@@ -1354,7 +1359,7 @@ where
         kalman.alternatives = u32::try_from(mixture.len()).unwrap_or(u32::MAX);
         // the estimate and its covariance: the mixture's moments, where
         // the filter keeps steps apart (each weight's `exp` once)
-        let ((dq, dv), reported) = if mixture.is_empty() {
+        let (mean, reported) = if mixture.is_empty() {
             (mixture::no_offset(), p)
         } else {
             let (mean, spread) = mixture.moments();
@@ -1362,11 +1367,7 @@ where
         };
         self.reported = reported;
         (self.outliers, self.report, self.kalman) = (outliers, report, kalman);
-        Ok(Estimate {
-            t: self.t,
-            q: self.q + dq,
-            v: self.v + dv,
-        })
+        Ok(self.estimate_at(mean))
     }
 }
 
