@@ -2009,7 +2009,7 @@ fn the_sum_is_not_overconfident_where_it_keeps_steps() {
 /// time-stepping plant"), the file's start was at 3.46 times `q90` and
 /// failed the first assertion.
 ///
-/// `cargo test --release --test kalman -- --nocapture posterior` (40 s)
+/// `cargo test --release --test kalman -- --nocapture posterior` (26 s)
 #[test]
 fn the_filter_beside_the_gaussian_posterior() {
     use common::posterior::{quantile, velocity_covariances, within};

@@ -30,6 +30,7 @@
 use moreau::{KalmanParams, Observer, SaltationKalman};
 use moreau_models::Parabola;
 use nalgebra::{Matrix2, SVector, Vector2};
+use std::sync::OnceLock;
 
 use super::runs::{Reference, measure};
 
@@ -81,13 +82,27 @@ fn spread(p: &Matrix2<f64>) -> (f64, f64) {
     (eig[0].max(0.0), eig[1].max(0.0))
 }
 
+/// The trapezoidal rule's points over a half turn, for [`within`].
+const POINTS: usize = 64;
+
+/// `(cos²θ, sin²θ)` at each of the [`POINTS`] directions `θ`: the same for
+/// every covariance and radius, so taken once rather than at each of the
+/// bisection's evaluations (which spent most of their time in `sin_cos`).
+fn directions() -> &'static [(f64, f64); POINTS] {
+    static DIRECTIONS: OnceLock<[(f64, f64); POINTS]> = OnceLock::new();
+    DIRECTIONS.get_or_init(|| {
+        std::array::from_fn(|j| {
+            let theta = std::f64::consts::PI * (j as f64 + 0.5) / POINTS as f64;
+            (theta.cos().powi(2), theta.sin().powi(2))
+        })
+    })
+}
+
 /// [`within`] from the eigenvalues `(λ₁, λ₂)` ([`spread`]).
 fn within_spread((l1, l2): (f64, f64), r: f64) -> f64 {
-    const POINTS: usize = 64;
     let mut sum = 0.0;
-    for j in 0..POINTS {
-        let theta = std::f64::consts::PI * (j as f64 + 0.5) / POINTS as f64;
-        let s = l1 * theta.cos().powi(2) + l2 * theta.sin().powi(2);
+    for &(cos2, sin2) in directions() {
+        let s = l1 * cos2 + l2 * sin2;
         sum += if s > 0.0 {
             1.0 - (-r * r / (2.0 * s)).exp()
         } else {
