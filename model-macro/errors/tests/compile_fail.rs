@@ -2,21 +2,22 @@
 //! it: the token's span inline, `file:line:column` for YAML. One case per
 //! rule under `tests/ui/<class>/`, and cases with several mistakes to show
 //! they are reported together. Refresh the expected `.stderr` files with
-//! `TRYBUILD=overwrite cargo test --test compile_fail`, then read the diff.
+//! `TRYBUILD=overwrite cargo test --release -p moreau-macro-errors`, then
+//! read the diff.
 
 use std::path::PathBuf;
 
 #[test]
 fn malformed_models_are_spanned_compile_errors() {
     // trybuild compiles each case inside its own crate, under
-    // `target/tests/trybuild/moreau`; a model file must lie inside the
-    // calling crate, so the YAML cases' files (and the URDFs they name) are
-    // copied there first.
+    // `target/tests/trybuild/moreau-macro-errors`; a model file must lie
+    // inside the calling crate, so the YAML cases' files (and the URDFs
+    // they name) are copied there first.
     let target = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .parent()
         .expect("the target directory")
         .to_path_buf();
-    let project_yaml = target.join("tests/trybuild/moreau/tests/ui/yaml");
+    let project_yaml = target.join("tests/trybuild/moreau-macro-errors/tests/ui/yaml");
     std::fs::create_dir_all(&project_yaml).expect("create the trybuild crate's model folder");
     let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/ui/yaml");
     for entry in std::fs::read_dir(&source).expect("tests/ui/yaml") {
