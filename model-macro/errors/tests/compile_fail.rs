@@ -17,7 +17,11 @@ fn malformed_models_are_spanned_compile_errors() {
         .parent()
         .expect("the target directory")
         .to_path_buf();
-    let project_yaml = target.join("tests/trybuild/moreau-macro-errors/tests/ui/yaml");
+    // trybuild names its project after this crate
+    let project_yaml = target
+        .join("tests/trybuild")
+        .join(env!("CARGO_PKG_NAME"))
+        .join("tests/ui/yaml");
     std::fs::create_dir_all(&project_yaml).expect("create the trybuild crate's model folder");
     let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/ui/yaml");
     for entry in std::fs::read_dir(&source).expect("tests/ui/yaml") {
