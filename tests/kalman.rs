@@ -1376,7 +1376,7 @@ fn the_filter_takes_samples_at_any_rate_on_every_shipped_model() {
         name: &str,
         start: (SVector<f64, N>, SVector<f64, N>),
     ) where
-        M: Sensitivities<N, K, Scalar = f64, Input: Default>,
+        M: Sensitivities<N, K, Scalar = f64, Input: Default> + std::fmt::Debug + 'static,
     {
         let u = M::Input::default();
         for every in [25, 100, 1000] {
@@ -2282,7 +2282,7 @@ fn drawn_starts() -> (Vec<Start>, Vec<Start>) {
 /// percentile, 2e-4.
 fn issues_numbers_on<M, const K: usize>(model: &M, starts: &[(Vector2<f64>, Vector2<f64>)]) -> usize
 where
-    M: Sensitivities<2, K, Scalar = f64, Input = SVector<f64, 0>>,
+    M: Sensitivities<2, K, Scalar = f64, Input = SVector<f64, 0>> + std::fmt::Debug + 'static,
 {
     let (u, sigma, window) = (SVector::zeros(), 1e-4, (2.0, 10.0));
     let name = M::INFO.name;
@@ -3118,7 +3118,7 @@ fn balls_left_touching_by_a_collapse_part_as_the_samples_show() {
 /// assertions.
 fn passes_the_corner_at_full_reach<M>(model: &M)
 where
-    M: Sensitivities<2, 2, Scalar = f64, Input = SVector<f64, 0>>,
+    M: Sensitivities<2, 2, Scalar = f64, Input = SVector<f64, 0>> + std::fmt::Debug + 'static,
 {
     let u = SVector::zeros();
     let mut g = Gauss::new(99);
@@ -4587,7 +4587,7 @@ fn exact_in_f32<M32, M64, const N: usize, const K: usize>(
 ) -> ExactF32
 where
     M32: Sensitivities<N, K, Scalar = f32>,
-    M64: Model<N, K, Scalar = f64>,
+    M64: Model<N, K, Scalar = f64> + std::fmt::Debug + 'static,
     M32::Input: Default,
     M64::Input: Default,
 {

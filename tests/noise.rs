@@ -65,7 +65,7 @@ fn check<M, const N: usize, const K: usize>(
     seeds: &[u64],
     (median, p90, clean): (f64, f64, f64),
 ) where
-    M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>>,
+    M: Model<N, K, Scalar = f64, Input = SVector<f64, 0>> + std::fmt::Debug + 'static,
 {
     let sigma = 1e-4;
     let data = reference(model, start, 1e-5, 100, 10.0, &SVector::zeros());

@@ -233,7 +233,7 @@ fn converges<M, const N: usize, const K: usize>(
     u: &M::Input,
 ) -> [(f64, Figures); 2]
 where
-    M: Model<N, K, Scalar = f64>,
+    M: Model<N, K, Scalar = f64> + std::fmt::Debug + 'static,
 {
     let t_end = 6.0;
     let data = reference(model, start, 1e-5, 100, t_end, u);

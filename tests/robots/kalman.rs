@@ -86,7 +86,7 @@ fn plant_run<M, const N: usize, const K: usize>(
     start: (SVector<f64, N>, SVector<f64, N>),
 ) -> Reference<N>
 where
-    M: Model<N, K, Scalar = f64, Input: Default>,
+    M: Model<N, K, Scalar = f64, Input: Default> + std::fmt::Debug + 'static,
 {
     let data = reference(model, start, 1e-5, 100, WINDOW.1, &M::Input::default());
     let fastest = data.samples.iter().map(|s| s.v.amax()).fold(0.0, f64::max);
@@ -373,7 +373,7 @@ fn the_filter_follows_a_panda_and_go1s_legs() {
 fn the_filter_follows_the_other_robots() {
     fn once<M, const N: usize, const K: usize>(model: &M, range: f64)
     where
-        M: Sensitivities<N, K, Scalar = f64, Input: Default>,
+        M: Sensitivities<N, K, Scalar = f64, Input: Default> + std::fmt::Debug + 'static,
     {
         let data = plant_run::<_, N, K>(model, starts::<_, N, K>(model, None, 1, range)[0]);
         check(M::INFO.name, 0, &run::<_, N, K>(model, &data, 7));
