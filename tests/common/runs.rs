@@ -65,8 +65,9 @@ pub fn reference_with<M, const N: usize, const K: usize>(
 where
     M: Model<N, K, Scalar = f64> + Debug + 'static,
 {
-    let samples = (t_end / params.tau).round() / every as f64;
-    if samples > KEPT_SAMPLES as f64 {
+    // the samples `plant_run` keeps: the start and every `every`-th step
+    let samples = (t_end / params.tau).round() as usize / every + 1;
+    if samples > KEPT_SAMPLES {
         return plant_run(model, start, params, every, t_end, u);
     }
     // everything the run depends on: the model's type and its values
