@@ -273,6 +273,98 @@ fn the_filter_follows_a_ur5_onto_and_off_a_table() {
     }
 }
 
+/// The UR5 of [`the_filter_follows_a_ur5_onto_and_off_a_table`] with a
+/// plastic table (`e = 0`, set on the model's `restitution`), on the same
+/// starts and noise: every strike stops the tool, which the plant then
+/// holds where its step left it, inside the table by up to `τ |ḣ|` (3.2e-5
+/// m at 3.4 m/s), while the arm slides it along and off.
+///
+/// The filter holds a struck contact at a level the samples teach (module
+/// docs of `runtime/src/observer/kalman/level.rs`). Its covariance once
+/// held the state on that level with no variance across it: it claimed
+/// the tool's gap to 7e-11 m while its level was 1e-6 m off the plant's
+/// (the gap's normalised error squared, median over the held samples, 1.2e7
+/// to 3.2e8 on these runs told the plant's step), and the claim went on
+/// into the flight after lift-off: velocity NEES medians 4.2 to 25 with the
+/// defaults. The level's variance is now in `P` along the way the
+/// manifold moves with it: gap medians 0.05 to 2.4 told the plant; NEES
+/// medians 2.4 to 11.6 with the defaults.
+///
+/// Asserted on every run, told the plant's step (`with_plant_step`: the
+/// level's prior is then the plant's penetration): the held gap's
+/// normalised error squared `(h(q̂) − h(q))² / J P_qq Jᵀ`, median over the
+/// samples where the plant holds the tool (its gap under 1e-6 m, off the
+/// bracketing samples), within the 99th percentile of χ² with one degree
+/// of freedom (6.63: a consistent filter's median is 0.455, and the claim
+/// without the level's variance missed the bound by six orders); no
+/// restart and at most one sample refused; the
+/// filter's median at least five times below (38)'s. Printed, not
+/// asserted: the defaults' figures, whose timing prior (impacts on time
+/// within 3 µs) puts one plant's penetration at 3.1 of its deviations
+/// (start 4: gap median 9.6, scratch run), and the velocity NEES, still above the χ²
+/// median where the arm slides the tool at 10 to 20 rad/s (module docs of
+/// `level.rs`).
+#[test]
+fn the_filter_follows_a_plastic_ur5_onto_and_off_a_table() {
+    let mut model = Ur5Table::<f64>::new();
+    model.restitution[0] = 0.0;
+    let starts = starts::<_, 6, 1>(&model, Some(Ur5Table::<f64>::initial_state()), 6, 1.5);
+    for (n, &start) in starts.iter().enumerate() {
+        let data = plant_run::<_, 6, 1>(&model, start);
+        let seed = 7 + n as u64;
+        let r = run(&model, &data, seed);
+        print("plastic UR5", n, &r);
+        let params = KalmanParams::new(VELOCITY_BOUND, SIGMA).with_plant_step(1e-5);
+        let told = run_with(&model, &data, seed, params);
+        print("plastic UR5 told the plant", n, &told);
+        let gaps = held_gap_errors(&model, &data, seed, params);
+        eprintln!(
+            "plastic UR5 told the plant, start {n}: held gap's normalised error squared, median {gaps:.3}"
+        );
+        let at = format!("plastic UR5, start {n}, told the plant");
+        assert_steady_and_ahead(&at, &told, 5.0);
+        assert!(gaps <= 6.63, "{at}: {gaps}");
+    }
+}
+
+/// The median over the window, on the samples (off the bracketing ones)
+/// where the plant holds a contact (its gap under 1e-6), of the filter's
+/// normalised error squared of that gap, `(h_i(q̂) − h_i(q))² / J_i P_qq
+/// J_iᵀ`, with the knobs `params` and the noise seed `seed`.
+fn held_gap_errors<M, const N: usize, const K: usize>(
+    model: &M,
+    data: &Reference<N>,
+    seed: u64,
+    params: KalmanParams<f64, N>,
+) -> f64
+where
+    M: Sensitivities<N, K, Scalar = f64, Input: Default>,
+{
+    let u = M::Input::default();
+    let measured = measure(data, SIGMA, seed);
+    let bracket = brackets(data);
+    let mut filter =
+        SaltationKalman::<f64, N, K>::new(params, 0.0, measured[0], SVector::zeros()).unwrap();
+    let mut errors = Vec::new();
+    observe_counting(&mut filter, model, (data, &measured), &u, |j, f| {
+        let s = &data.samples[j];
+        if s.t < WINDOW.0 || bracket[j] {
+            return;
+        }
+        let q = f.estimate().q;
+        let (plant, estimate, jac) = (model.gaps(&s.q), model.gaps(&q), model.gap_jacobian(&q));
+        for i in 0..K {
+            if plant[i] < 1e-6 {
+                let row = jac.row(i);
+                let variance = (row * f.covariance().qq).dot(&row);
+                errors.push((estimate[i] - plant[i]).powi(2) / variance);
+            }
+        }
+    });
+    errors.sort_by(f64::total_cmp);
+    errors[errors.len() / 2]
+}
+
 /// A Franka Panda (seven joints, no damping: its wrist whips up to 67
 /// rad/s) and Go1's legs (twelve joints, six constraints), four and three
 /// random starts.

@@ -50,8 +50,20 @@
 //! ([`project_onto_contact`](super::saltation::project_onto_contact)) then
 //! moves the state onto `h_S = ℓ_S`, and a sample is read on the contact
 //! ([`Interval::read_on_contacts`](crate::observer::interval)) relative to
-//! the level. The level's own uncertainty is not in `P`: the state is held
-//! at its mean.
+//! the level. The projection takes every variance across the contact,
+//! and the level's own is put back: the manifold moves with each level,
+//! by `J⁺ δℓ` in position and `−J⁺ D J⁺ δℓ` in velocity (`J⁺` and `D` of
+//! the projection), so `P` gains `C diag(s²) Cᵀ` along those directions
+//! (`level_spread` in module `propagate`). A sample then moves the state
+//! across the contact by about what it moves the level, and the next
+//! projection finds the state where the level now is. Without it the
+//! filter held a plastic UR5's tool on a level 1e-6 m off the plant's
+//! while it claimed the gap to 7e-11 m, the velocity NEES median over the
+//! held samples was 3.6 to 23 on six starts (χ² median 5.35), and after
+//! lift-off the claim went on into the flight (NEES medians up to 59);
+//! with it 2.7 to 12 held and 0.95 to 14 in flight, and medians 2.1e-5
+//! to 5.9e-5 rad/s instead of 2.6e-5 to 5.9e-5 (`tests/robots/kalman.rs`,
+//! `the_filter_follows_a_plastic_ur5_onto_and_off_a_table`).
 
 use nalgebra::{RealField, SMatrix, SVector};
 
@@ -80,6 +92,11 @@ impl<T: RealField + Copy, const K: usize> Levels<T, K> {
             deepest: SVector::zeros(),
             held: IndexSet::EMPTY,
         }
+    }
+
+    /// `s_i²`: `0` for a contact not held, or held without an impact.
+    pub fn variance(&self) -> SVector<T, K> {
+        self.variance
     }
 
     /// Whether no contact was held at the end of the last update (every

@@ -78,9 +78,11 @@
 //!      is the part of the noise's position and velocity variances that
 //!      the projection took, put back uncorrelated: `P` stays positive
 //!      definite, and a penetration seen in exact samples moves the
-//!      position estimate, not the velocity. The piece starts with the
-//!      separating normal speed of the held constraints that push taken
-//!      out in the same metric (`Interval::settled`), so the force that
+//!      position estimate, not the velocity; and the variance of each
+//!      level, along the way the manifold moves with it (module
+//!      `level`). The piece starts with the separating normal speed of
+//!      the held constraints that push taken out in the same metric
+//!      (`Interval::settled`), so the force that
 //!      holds them does no work on an estimate leaving them: the
 //!      prediction never gains energy from a contact (`tests/kalman.rs`,
 //!      `a_held_contact_does_no_work_on_a_separating_estimate`).
@@ -1503,7 +1505,7 @@ impl<T: RealField + Copy, const N: usize, const K: usize> SaltationKalman<T, N, 
             (self.t, interval.tau),
             &self.params,
             (self.p, self.mixture),
-            (Some(self.held_since), self.levels.mean),
+            (Some(self.held_since), &self.levels),
         );
         if self.fresh {
             propagation = propagation.relinearised((self.q - q, v0 - w));

@@ -511,7 +511,7 @@ where
 }
 
 /// What [`project_onto_contact`] returns.
-pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
+pub(crate) struct Projection<T: RealField + Copy, const N: usize, const K: usize> {
     /// `B P Bᵀ`.
     pub p: Blocks<T, N>,
     /// The projector `B` itself.
@@ -520,6 +520,11 @@ pub(crate) struct Projection<T: RealField + Copy, const N: usize> {
     pub dq: SVector<T, N>,
     /// The state's move onto the manifold, velocity part.
     pub dv: SVector<T, N>,
+    /// How the manifold moves with the levels `ℓ_S`: a change `δℓ` moves
+    /// its points by `level.0 δℓ` (`J⁺`, so `J_S δq = δℓ`) and their
+    /// velocities by `level.1 δℓ` (`−J⁺ D J⁺`, so `J_S v = 0` still holds
+    /// to first order); zero columns off `set`.
+    pub level: (SMatrix<T, N, K>, SMatrix<T, N, K>),
 }
 
 /// Projects the state's perturbations onto the tangent space of the
@@ -547,7 +552,7 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
     rate: &SMatrix<T, K, N>,
     v: &SVector<T, N>,
     set: IndexSet<K>,
-) -> Option<Projection<T, N>> {
+) -> Option<Projection<T, N, K>> {
     let mut d = SMatrix::<T, K, N>::zeros();
     let mut r_h = SVector::<T, K>::zeros();
     for i in set {
@@ -576,6 +581,7 @@ pub(crate) fn project_onto_contact<T: RealField + Copy, const N: usize, const K:
         map: b,
         dq,
         dv,
+        level: (pinv, -(pinv * d * pinv)),
     })
 }
 
