@@ -291,9 +291,9 @@ where
     /// The constraints held along the last piece (pushing), if it ended
     /// the interval: the contacts the predicted end lies on.
     pub held: IndexSet<K>,
-    /// The gaps the held contacts are held at (module `level`), and
-    /// their variances.
-    levels: (SVector<T, K>, SVector<T, K>),
+    /// The gaps the held contacts are held at, and their variances
+    /// (module `level`).
+    levels: Levels<T, K>,
     /// The fastest approach `−J_i w⁻` of each constraint that took an
     /// impulse at an impact of the interval (`0` where none did).
     pub struck: SVector<T, K>,
@@ -358,7 +358,7 @@ where
             saltations: 0,
             projections: 0,
             held: IndexSet::EMPTY,
-            levels: (levels.mean, levels.variance()),
+            levels: *levels,
             struck: SVector::zeros(),
         }
     }
@@ -874,21 +874,26 @@ where
                 project_onto_contact(
                     &p,
                     &mass,
-                    &(h - self.levels.0),
+                    &(h - self.levels.mean),
                     &jac,
                     &rate,
                     piece.w1,
                     ends_on,
                 )
             };
-            let mut level = Blocks::diagonal(SMatrix::zeros(), SMatrix::zeros());
+            let mut level = None;
             if let Some(projection) = projection {
                 p = projection.p;
                 across -= projection.map.qq;
                 self.correction = (projection.dq, projection.dv);
                 self.carry_offset(&projection.map);
                 self.projections += 1;
-                level = level_spread(&projection.level, &self.levels.1);
+                // (a contact held without an impact has no variance: nothing
+                // to add)
+                let variance = self.levels.variance();
+                if variance.iter().any(|&s| s > T::zero()) {
+                    level = Some(level_spread(&projection.level, &variance));
+                }
             }
             // what the contact leaves uncertain across it: the part of
             // the piece's noise that the projection took (`I − Π` of its
@@ -898,12 +903,13 @@ where
             // is still in `P`, and adding it again counted it twice (the
             // three balls' glued pair, held at every step, 10 to 22 %
             // higher medians at σ = 1e-4)
-            p = p
-                .add(&Blocks::diagonal(
-                    across * noise.qq * across.transpose(),
-                    across * noise.vv * across.transpose(),
-                ))
-                .add(&level);
+            p = p.add(&Blocks::diagonal(
+                across * noise.qq * across.transpose(),
+                across * noise.vv * across.transpose(),
+            ));
+            if let Some(level) = level {
+                p = p.add(&level);
+            }
         }
         if let Some(open) = open {
             let (a_free, _) = flow_jacobian(self.model, t, piece.p0, &w0, self.u)?;
