@@ -313,17 +313,16 @@ fn the_filter_follows_a_ur5_onto_and_off_a_table() {
 /// bracketing samples), within the 99th percentile of χ² with one degree
 /// of freedom (6.63: a consistent filter's median is 0.455, and the claim
 /// without the level's variance missed the bound by six orders); no
-/// restart and at most one sample refused; the
-/// filter's median at least five times below (38)'s. And with the
+/// restart and at most one sample refused; the filter's median at least
+/// five times below (38)'s. And with the
 /// defaults on the plant's exact positions, the median of at most
 /// 1e-8 (measured 9.1e-10 to 4.7e-9; 1.5e-8 and 2.6e-8 on two starts while
 /// the deepest level was three deviations of the impact's timing, module
-/// docs of `level.rs`). Printed, not
-/// asserted: the defaults' figures, whose timing prior (impacts on time
-/// within 3 µs) puts one plant's penetration at 3.1 of its deviations
-/// (start 4: gap median 9.6, scratch run), and the velocity NEES, still above the χ²
-/// median where the arm slides the tool at 10 to 20 rad/s (module docs of
-/// `level.rs`).
+/// docs of `level.rs`). Printed, not asserted: the defaults' figures,
+/// whose timing prior (impacts on time within 3 µs) puts one plant's
+/// penetration at 3.1 of its deviations (start 4: gap median 9.6), and
+/// the velocity NEES, still above the χ² median where the arm slides the
+/// tool at 10 to 20 rad/s (module docs of `level.rs`).
 #[test]
 fn the_filter_follows_a_plastic_ur5_onto_and_off_a_table() {
     let mut model = Ur5Table::<f64>::new();
@@ -334,6 +333,11 @@ fn the_filter_follows_a_plastic_ur5_onto_and_off_a_table() {
         let seed = 7 + n as u64;
         let r = run(&model, &data, seed);
         print("plastic UR5", n, &r);
+        if let Some(gaps) = r.held_gap {
+            eprintln!(
+                "plastic UR5, start {n}: held gap's normalised error squared, median {gaps:.3}"
+            );
+        }
         let params = KalmanParams::new(VELOCITY_BOUND, SIGMA).with_plant_step(1e-5);
         let told = run_with(&model, &data, seed, params);
         print("plastic UR5 told the plant", n, &told);
