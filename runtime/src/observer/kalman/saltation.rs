@@ -110,7 +110,11 @@ where
 ///
 /// `∂c/∂q` needs third derivatives of `h` and is left out: exact for gaps
 /// of degree two (Example 1's parabola, the balls' distances, the
-/// billiard's walls), a Jacobian error of order `|v|² |∇³h|` otherwise.
+/// billiard's walls), a Jacobian error of order `|v|² |∇³h|` otherwise
+/// (measured on the plastic UR5 sliding its tool at up to 21 rad/s:
+/// adding the term by central differences moved the filter's velocity
+/// NEES medians by at most 0.07; `docs/estimation-under-noise.md`, "The
+/// level's variance in `P`").
 /// Constraints of `set` whose multiplier `λ_i` is not positive (the
 /// motion leaves them) are dropped. Falls back to [`flow_jacobian`] when
 /// none is left.
