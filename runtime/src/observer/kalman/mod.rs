@@ -67,7 +67,9 @@
 //!      `propagate`), `h_S(q) = ℓ_S` and `J_S(q) v = 0` (`ℓ` the levels
 //!      the contacts are held at: `0`, the rigid surface, unless an
 //!      impact into the contact and the samples since put it deeper,
-//!      module `level`), linearised as
+//!      module `level`: states of the filter, their covariance and its
+//!      correlation with `(q, v)` carried through the projection and the
+//!      update), linearised as
 //!      `J_S δq = 0` and `∂(J_S v)/∂q δq + J_S δv = 0`
 //!      ([`Sensitivities::jacobian_dq`]), in the metric of `M` (that of a
 //!      plastic impact): `P ← B P Bᵀ`, a congruence, so positive
@@ -152,9 +154,11 @@
 //!    `(I − K H)`; the gate takes the smallest of their innovations; the
 //!    estimate is their mean and [`SaltationKalman::covariance`] holds
 //!    their spread ([`KalmanReport::alternatives`]). The levels of the
-//!    contacts held at the end follow (module `level`): a contact struck
-//!    in the interval takes the depth a delayed impact leaves, and the
-//!    sample, when used, measures it by a scalar Kalman update.
+//!    contacts held at the end are updated with the state, through their
+//!    correlation with it, and follow (module `level`): a contact struck
+//!    in the interval takes the depth a delayed impact leaves, which the
+//!    sample, when used, measures by a scalar Kalman update until the
+//!    state carries it.
 //!
 //! Every congruence `B P Bᵀ` above (flow, saltation, projection, Joseph
 //! update) adds on its diagonal what covers its own rounding
@@ -822,8 +826,9 @@ pub struct SaltationKalman<T: RealField + Copy, const N: usize, const K: usize> 
     /// sample's time): how long the contacts held since have been
     /// (module `propagate`, "A contact that may hover").
     held_since: SVector<T, K>,
-    /// The gaps the held contacts are held at (module `level`).
-    levels: Levels<T, K>,
+    /// The gaps the held contacts are held at, their covariance and its
+    /// correlation with the state (module `level`).
+    levels: Levels<T, N, K>,
     /// The case the samples build against each held contact (module
     /// `opening`).
     openings: Openings<T, K>,
@@ -1277,6 +1282,9 @@ where
         mixture.drop_open(t);
         let theirs = mixture.innovations(&y, |x| chol.solve(x));
         let gated = mixture.least_nis(nis, &theirs);
+        // the levels' correlation with the state as the prediction carried
+        // it, measured with the state below (module `level`)
+        let mut levels = propagation.levels;
         let (q_new, v_new) = if gated > gate && !kalman.inflated {
             kalman.outlier = true;
             outliers += 1;
@@ -1286,6 +1294,7 @@ where
             // UPDATE, Joseph form
             let k_q = chol.solve(&p.qq).transpose();
             let k_v = chol.solve(&p.qv).transpose();
+            levels.update(&p, (&k_q, &k_v), &r, |x| chol.solve(x), &y);
             p = p.joseph_position_update(&k_q, &k_v, &r);
             // each step's own innovation reweighs it, the likeliest
             // becoming the state (module `mixture`)
@@ -1321,6 +1330,7 @@ where
         }
         (self.t, self.q, self.v, self.p) = (t, q_new, v_new, p);
         self.mixture = mixture;
+        self.levels = levels;
         for i in 0..K {
             if !propagation.held.contains(i) || report.impacted.contains(i) {
                 self.held_since[i] = t;

@@ -291,9 +291,10 @@ where
     /// The constraints held along the last piece (pushing), if it ended
     /// the interval: the contacts the predicted end lies on.
     pub held: IndexSet<K>,
-    /// The gaps the held contacts are held at, and their variances
-    /// (module `level`).
-    levels: Levels<T, K>,
+    /// The gaps the held contacts are held at, their covariance and its
+    /// correlation with the state, carried along the interval (module
+    /// `level`; only the correlation changes here).
+    pub levels: Levels<T, N, K>,
     /// The fastest approach `−J_i w⁻` of each constraint that took an
     /// impulse at an impact of the interval (`0` where none did).
     pub struck: SVector<T, K>,
@@ -317,7 +318,7 @@ where
         (t0, length): (T, T),
         params: &KalmanParams<T, N>,
         (p, mixture): (Blocks<T, N>, Mixture<T, N>),
-        (held_since, levels): (Option<SVector<T, K>>, &Levels<T, K>),
+        (held_since, levels): (Option<SVector<T, K>>, &Levels<T, N, K>),
     ) -> Self {
         let square = |x: T| x * x;
         // the samples lie on the plant's grid where the interval is a
@@ -824,6 +825,7 @@ where
             let phi = flow_transition(&a, piece.h);
             (phi, phi.congruence_covered(&self.p))
         };
+        self.levels.map_state(&phi);
         self.held = held;
         // an alternative with a contact open that the state holds flies
         // free, not along the contact (carried again below)
@@ -888,11 +890,11 @@ where
                 self.correction = (projection.dq, projection.dv);
                 self.carry_offset(&projection.map);
                 self.projections += 1;
-                // (a contact held without an impact has no variance: nothing
-                // to add)
-                let variance = self.levels.variance();
-                if variance.iter().any(|&s| s > T::zero()) {
-                    level = Some(level_spread(&projection.level, &variance));
+                // the levels' own covariance and their correlation with
+                // the state (a contact held without an impact has no
+                // variance: nothing to add)
+                if self.levels.uncertain() {
+                    level = Some(self.levels.project(&projection));
                 }
             }
             // what the contact leaves uncertain across it: the part of
@@ -1026,6 +1028,10 @@ where
             _ => self.p,
         };
         self.p = map.congruence_covered(&prior).add(&noise).symmetrized();
+        // (the levels' correlation mapped as the state is; a plant's
+        // step window's conditioning of `P`, module `grid`, leaves it as
+        // it was)
+        self.levels.map_state(&map);
         // a closure with no bounce is the state's contact: an alternative
         // that has it open does not meet it
         let plastic = jump.elastic.intersection(active).is_empty();
@@ -1246,29 +1252,4 @@ where
     let (state, _) = plant_step(model, u, (t, q, v_minus), plant)?;
     let (q_exact, v_exact) = flown(model, u, (t, q, v_plus), plant.tau)?;
     finite((state.q - q_exact, state.v - v_exact))
-}
-
-/// The covariance the levels' own variances `s²` give a state held on the
-/// contact manifold `h_S = ℓ_S` (module `level`): the manifold moves with
-/// each level, by `map` per unit (`Projection::level`), and the levels'
-/// errors are independent, so `C diag(s²) Cᵀ` with `C` the two blocks of
-/// `map`. The projection took every variance across the contact; the
-/// state's distance from the true contact is the level's error, which the
-/// samples measure, not nothing: without it the filter claimed the gap of
-/// a plastic UR5's tool to 7e-11 m while the level it held was 1e-6 m off
-/// the plant's, and carried that claim into the flight after lift-off
-/// (velocity NEES medians up to 59 over the flight, where 5.35 is the χ²
-/// median).
-fn level_spread<T: RealField + Copy, const N: usize, const K: usize>(
-    map: &(SMatrix<T, N, K>, SMatrix<T, N, K>),
-    variance: &SVector<T, K>,
-) -> Blocks<T, N> {
-    let deviation = SMatrix::<T, K, K>::from_diagonal(&variance.map(|s| s.max(T::zero()).sqrt()));
-    let (cq, cv) = (map.0 * deviation, map.1 * deviation);
-    Blocks {
-        qq: cq * cq.transpose(),
-        qv: cq * cv.transpose(),
-        vq: cv * cq.transpose(),
-        vv: cv * cv.transpose(),
-    }
 }
