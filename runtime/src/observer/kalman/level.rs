@@ -227,7 +227,9 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Levels<T, N, K> {
         // correlation left (a negative variance would take `P`'s
         // definiteness with it at the next projection)
         for i in 0..K {
-            if !(self.covariance[(i, i)] > T::zero()) {
+            let positive = self.covariance[(i, i)].partial_cmp(&T::zero())
+                == Some(core::cmp::Ordering::Greater);
+            if !positive {
                 let mean = self.mean[i];
                 let deepest = self.deepest[i];
                 self.forget(i);
