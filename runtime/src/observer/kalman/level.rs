@@ -230,22 +230,25 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Levels<T, N, K> {
             let positive = self.covariance[(i, i)].partial_cmp(&T::zero())
                 == Some(core::cmp::Ordering::Greater);
             if !positive {
-                let mean = self.mean[i];
-                let deepest = self.deepest[i];
-                self.forget(i);
-                (self.mean[i], self.deepest[i]) = (mean, deepest);
+                self.decorrelate(i);
             }
         }
     }
 
     /// Contact `i` forgets its level: no mean, no variance, no correlation.
     fn forget(&mut self, i: usize) {
+        self.decorrelate(i);
         self.mean[i] = T::zero();
+        self.deepest[i] = T::zero();
+    }
+
+    /// Level `i` taken as known: no variance and no correlation with the
+    /// state or the other levels, its mean and bound kept.
+    fn decorrelate(&mut self, i: usize) {
         self.covariance.row_mut(i).fill(T::zero());
         self.covariance.column_mut(i).fill(T::zero());
         self.cross.0.column_mut(i).fill(T::zero());
         self.cross.1.column_mut(i).fill(T::zero());
-        self.deepest[i] = T::zero();
     }
 
     /// The levels of the struck contacts held at the end of an update
@@ -273,10 +276,8 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Levels<T, N, K> {
             // (`deepest < 0`: struck since it was last released)
             if self.deepest[i] < T::zero() && h[i].is_finite() {
                 let row = jac.row(i);
-                let (mean, deepest) = (h[i].max(self.deepest[i]).min(T::zero()), self.deepest[i]);
-                self.forget(i);
-                self.mean[i] = mean;
-                self.deepest[i] = deepest;
+                self.decorrelate(i);
+                self.mean[i] = h[i].max(self.deepest[i]).min(T::zero());
                 self.covariance[(i, i)] = (row * measurement).dot(&row);
             }
         }
