@@ -172,23 +172,17 @@ impl<T: RealField + Copy, const N: usize, const K: usize> Levels<T, N, K> {
         let b = &projection.map;
         let (gq, gv) = projection.level;
         let (xq, xv) = self.cross;
-        // B X
+        // B X, and the new cross Y = B X + G S
         let (bq, bv) = (b.qq * xq + b.qv * xv, b.vq * xq + b.vv * xv);
-        // G S
-        let (sq, sv) = (gq * self.covariance, gv * self.covariance);
-        let gained = |a: &SMatrix<T, N, K>, c: &SMatrix<T, N, K>, g: &SMatrix<T, N, K>| {
-            // a gᵀ + g aᵀ + c gᵀ, with c = g S
-            a * g.transpose() + g * a.transpose() + c * g.transpose()
-        };
-        let qq = gained(&bq, &sq, &gq);
-        let vv = gained(&bv, &sv, &gv);
-        let qv = bq * gv.transpose() + gq * bv.transpose() + sq * gv.transpose();
-        self.cross = (bq + sq, bv + sv);
+        let (yq, yv) = (bq + gq * self.covariance, bv + gv * self.covariance);
+        // B X Gᵀ + G Xᵀ Bᵀ + G S Gᵀ = Y Gᵀ + G (B X)ᵀ
+        let qv = yq * gv.transpose() + gq * bv.transpose();
+        self.cross = (yq, yv);
         Blocks {
-            qq,
+            qq: yq * gq.transpose() + gq * bq.transpose(),
             qv,
             vq: qv.transpose(),
-            vv,
+            vv: yv * gv.transpose() + gv * bv.transpose(),
         }
     }
 
